@@ -1,0 +1,86 @@
+//! The error type of mesh generation.
+
+use thiserror::Error;
+
+/// Everything that can stop [`generate`](crate::generate) before it returns a mesh.
+///
+/// Each message says what was wrong and what to do about it.
+#[derive(Debug, Clone, PartialEq, Error)]
+pub enum MeshError {
+    /// A parameter is NaN or infinite.
+    #[error("parameter `{name}` is {value}; it must be a finite number")]
+    NonFinite {
+        /// Parameter name.
+        name: &'static str,
+        /// The value found.
+        value: f64,
+    },
+    /// The initial direction has no component in the tangent plane at `p0`.
+    #[error(
+        "the initial direction w00 = {w00:?} is parallel to the normal {normal:?} at p0; \
+         choose a direction with a component in the tangent plane"
+    )]
+    DirectionParallelToNormal {
+        /// The direction given.
+        w00: [f64; 3],
+        /// The field's normal at `p0`.
+        normal: [f64; 3],
+    },
+    /// `v(p0)` is zero or not finite, so `p0` has no tangent plane.
+    #[error(
+        "the normal field vanishes (or is not finite) at p0 = {p0:?}: {normal:?}; \
+         p0 is a singular point, choose another initial point"
+    )]
+    SingularInitialPoint {
+        /// The initial point.
+        p0: [f64; 3],
+        /// The field value there.
+        normal: [f64; 3],
+    },
+    /// `β_min ≥ β_max`, or the band is not inside (0°, 90°).
+    #[error(
+        "the normal-angle band [β_min, β_max] = [{min_deg}°, {max_deg}°] is invalid; \
+         it needs 0 < β_min < β_max < 90 degrees"
+    )]
+    AngleBand {
+        /// β_min in degrees.
+        min_deg: f64,
+        /// β_max in degrees.
+        max_deg: f64,
+    },
+    /// A step length or step bound is not positive, or the bounds are inverted.
+    #[error("step size {name} = {value} is invalid: {why}")]
+    StepSize {
+        /// Which parameter.
+        name: &'static str,
+        /// The value found.
+        value: f64,
+        /// What is required.
+        why: &'static str,
+    },
+    /// `δ ≤ 1`.
+    #[error("the growth factor δ = {0} must be greater than 1 (the step grows when the normal turns too little)")]
+    GrowthFactor(f64),
+    /// `δ' ≥ 1` or `δ' ≤ 0`.
+    #[error("the shrink factor δ' = {0} must lie strictly between 0 and 1 (the step shrinks when the normal turns too much)")]
+    ShrinkFactor(f64),
+    /// A budget is zero.
+    #[error("the budget `{0}` is zero; every budget must allow at least one unit of work")]
+    ZeroBudget(&'static str),
+    /// A threshold factor is out of range.
+    #[error("parameter `{name}` = {value} is out of range: {why}")]
+    OutOfRange {
+        /// Which parameter.
+        name: &'static str,
+        /// The value found.
+        value: f64,
+        /// What is allowed.
+        why: &'static str,
+    },
+    /// The previous method needs at least three curves to span the tangent plane.
+    #[error("the previous method needs at least 3 curves (got {0}); use --curves 3 or more")]
+    TooFewCurves(usize),
+    /// The samples could not be triangulated (too few points, all points collinear in the chart…).
+    #[error("could not triangulate the samples: {0}")]
+    Triangulation(String),
+}

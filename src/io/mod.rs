@@ -1,0 +1,3 @@
+//! Reading and writing: mesh files, reports, invariant files, pictures.
+
+pub mod report;

@@ -1,0 +1,69 @@
+//! The JSON run report (`--report FILE.json`).
+
+use crate::model::Invariant;
+use crate::params::MeshParams;
+use crate::quality::Topology;
+use crate::scalar::ScalarKind;
+use crate::triangulate::Mesh;
+use serde::{Deserialize, Serialize};
+
+/// What a meshing run reports: counts, topology, time, and everything needed to rerun it.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Report {
+    /// Preset name, if the run used one.
+    pub preset: Option<String>,
+    /// The invariant's numbers (6 or 18).
+    pub invariant: Vec<f64>,
+    /// Whether `H` lies in sp(6).
+    pub hamiltonian_in_sp6: bool,
+    /// Scalar type the samples were computed in.
+    pub scalar: ScalarKind,
+    /// Mesh vertices.
+    pub vertices: usize,
+    /// Mesh triangles.
+    pub triangles: usize,
+    /// Integral curves traced (initial and inserted).
+    pub curves: usize,
+    /// No boundary, manifold and consistently oriented.
+    pub closed: bool,
+    /// `V − E + F`.
+    pub euler_characteristic: i64,
+    /// Number of boundary loops.
+    pub boundary_loops: usize,
+    /// Full topology.
+    pub topology: Topology,
+    /// Wall-clock seconds for sampling and triangulation.
+    pub seconds: f64,
+    /// The parameters used.
+    pub parameters: MeshParams,
+}
+
+impl Report {
+    /// Builds a report for `mesh`.
+    pub fn new(
+        preset: Option<String>,
+        invariant: &Invariant,
+        scalar: ScalarKind,
+        mesh: &Mesh,
+        curves: usize,
+        seconds: f64,
+        parameters: &MeshParams,
+    ) -> Report {
+        let topology = Topology::of(mesh);
+        Report {
+            preset,
+            invariant: invariant.numbers(),
+            hamiltonian_in_sp6: invariant.is_in_sp6(),
+            scalar,
+            vertices: mesh.vertices.len(),
+            triangles: mesh.triangles.len(),
+            curves,
+            closed: topology.closed,
+            euler_characteristic: topology.euler_characteristic,
+            boundary_loops: topology.boundary_loops,
+            topology,
+            seconds,
+            parameters: parameters.clone(),
+        }
+    }
+}

@@ -1,0 +1,79 @@
+//! # liemesh
+//!
+//! Adaptive triangle meshes of surfaces defined by Lie-algebra invariants (Sagara & Makino,
+//! "A High Quality Mesh Generation with Automatic Differentiation for Surfaces Defined by
+//! Hamiltonian Lie Algebra"), generic over the scalar type so that every number can be
+//! audited against MPFR.
+//!
+//! The pipeline, one module per stage, data flowing one way:
+//! [`scalar`] → [`model`] → [`trace`] → [`sample`] → [`triangulate`] → [`quality`] → [`io`].
+//!
+//! ```
+//! use liemesh::{generate, model::{Invariant, LieField}, preset::Preset};
+//!
+//! // The unit sphere (Table 2, Fig. 1–3), meshed by the proposed method in f64.
+//! let invariant = Invariant::from_numbers(&[1.0, 1.0, 1.0, 0.0, 0.0, 0.0])?;
+//! let field = LieField::<f64>::new(&invariant);
+//! let mesh = generate(&field, &Preset::Fig3.params())?;
+//! let topology = liemesh::quality::Topology::of(&mesh);
+//! assert!(topology.closed && topology.euler_characteristic == 2);
+//! for v in &mesh.vertices {
+//!     let r = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+//!     assert!((r - 1.0).abs() < 1e-12);
+//! }
+//! # Ok::<(), Box<dyn std::error::Error>>(())
+//! ```
+#![warn(missing_docs)]
+
+pub mod cli;
+mod error;
+pub mod io;
+pub mod model;
+mod params;
+pub mod preset;
+pub mod quality;
+pub mod sample;
+pub mod scalar;
+pub mod trace;
+pub mod triangulate;
+
+pub use error::MeshError;
+pub use model::NormalField;
+pub use params::{Budget, MeshParams, Method, Mode, Terminal};
+pub use triangulate::{Mesh, Provenance};
+
+use scalar::Scalar;
+
+/// Everything one meshing run produced.
+#[derive(Clone, Debug)]
+pub struct MeshRun<T> {
+    /// The sample points in the working precision, with curves and step records.
+    pub samples: sample::Samples<T>,
+    /// The chart triangulation behind the mesh.
+    pub chart: triangulate::ChartTriangulation,
+    /// The mesh.
+    pub mesh: Mesh,
+}
+
+/// Samples and triangulates the surface of `field` (the whole pipeline), keeping the
+/// intermediate results.
+pub fn run<T: Scalar, F: NormalField<T>>(
+    field: &F,
+    params: &MeshParams,
+) -> Result<MeshRun<T>, MeshError> {
+    let samples = sample::sample(field, params)?;
+    let (mesh, chart) = triangulate::triangulate(&samples, params.terminal.close)?;
+    Ok(MeshRun {
+        samples,
+        chart,
+        mesh,
+    })
+}
+
+/// Meshes the surface of `field` with `params`.
+pub fn generate<T: Scalar, F: NormalField<T>>(
+    field: &F,
+    params: &MeshParams,
+) -> Result<Mesh, MeshError> {
+    run(field, params).map(|r| r.mesh)
+}

@@ -1,0 +1,253 @@
+//! Normal fields: what the mesher consumes.
+
+use super::invariant::{Invariant, Lift, Mat3};
+use crate::scalar::{Dual, Scalar, Vec3};
+
+/// A normal field `v: R³ → R³` evaluated in the scalar type `T`.
+///
+/// The mesher needs the field value and one Jacobian-vector product `J_v(p) w` per step
+/// (the paper's eq. 8–9). Implement both for your own field, or wrap a closure written for
+/// dual numbers in [`FnField`], which gets both from one forward-mode pass.
+///
+/// Implement it for every `T: Scalar` at once to be able to audit your field in `f32`, `f64`
+/// and MPFR:
+///
+/// ```
+/// use liemesh::model::NormalField;
+/// use liemesh::scalar::{Dual, Scalar, Vec3};
+///
+/// /// The unit sphere's field `v(p) = p`.
+/// struct Radial;
+/// impl<T: Scalar> NormalField<T> for Radial {
+///     fn normal(&self, p: &Vec3<T>) -> Vec3<T> {
+///         p.clone()
+///     }
+///     fn normal_and_jvp(&self, p: &Vec3<T>, w: &Vec3<T>) -> (Vec3<T>, Vec3<T>) {
+///         (p.clone(), w.clone())
+///     }
+/// }
+/// let (v, jw) = NormalField::<f64>::normal_and_jvp(&Radial, &Vec3::new(0.0, 0.0, 1.0), &Vec3::new(1.0, 0.0, 0.0));
+/// assert_eq!((v.z, jw.x), (1.0, 1.0));
+/// ```
+pub trait NormalField<T: Scalar> {
+    /// `v(p)`.
+    fn normal(&self, p: &Vec3<T>) -> Vec3<T>;
+    /// `(v(p), J_v(p) w)`.
+    fn normal_and_jvp(&self, p: &Vec3<T>, w: &Vec3<T>) -> (Vec3<T>, Vec3<T>);
+}
+
+impl<T: Scalar, F: NormalField<T> + ?Sized> NormalField<T> for &F {
+    #[inline(always)]
+    fn normal(&self, p: &Vec3<T>) -> Vec3<T> {
+        (**self).normal(p)
+    }
+    #[inline(always)]
+    fn normal_and_jvp(&self, p: &Vec3<T>, w: &Vec3<T>) -> (Vec3<T>, Vec3<T>) {
+        (**self).normal_and_jvp(p, w)
+    }
+}
+
+/// The field of an [`Invariant`]: `v(p) = A p + B ℓ₂(p)`, the upper block of `H ℓ(p)`.
+///
+/// The matrices are stored in the scalar type `T`, so an `f64` field never converts per
+/// evaluation, an MPFR field has MPFR-accurate rotations, and a `Dual<f64>` field built
+/// with [`LieField::seeded`] carries the derivative with respect to one invariant number.
+///
+/// The JVP is one forward-mode pass with a dual number seeded with `w` (eq. 8–9); the
+/// matrix entries stay plain `T` and scale the dual components directly.
+#[derive(Clone, Debug)]
+pub struct LieField<T> {
+    a: Mat3<T>,
+    b: Mat3<T>,
+    c: Mat3<T>,
+    lift: Lift,
+    /// `false` when `B = 0`: the quadratic term is skipped (the linear model).
+    quadratic: bool,
+}
+
+impl<T: Scalar> LieField<T> {
+    /// The field of `invariant`, with matrices computed in `T`.
+    pub fn new(invariant: &Invariant) -> Self {
+        Self::from_parameters(&invariant.parameters::<T>())
+    }
+
+    /// The field whose invariant number `index` (in the 18-number layout: row-major over
+    /// Table 2's three rows, so 0..6 build `A`) is the dual variable: running the mesher on
+    /// it gives every vertex's derivative with respect to that number.
+    pub fn seeded(invariant: &Invariant, index: usize) -> LieField<Dual<T>> {
+        let params: Vec<Dual<T>> = invariant
+            .parameters::<T>()
+            .into_iter()
+            .enumerate()
+            .map(|(i, x)| if i == index { Dual::variable(x) } else { Dual::constant(x) })
+            .collect();
+        LieField::from_parameters(&params)
+    }
+
+    /// The field from the 18 numbers of the Table 2 layout, already in `T`.
+    pub fn from_parameters(params: &[T]) -> Self {
+        let a = Invariant::row_matrix(&params[0..6]);
+        let b = Invariant::row_matrix(&params[6..12]);
+        let c = Invariant::row_matrix(&params[12..18]);
+        let quadratic = b.iter().any(|r| !(r.x.is_zero() && r.y.is_zero() && r.z.is_zero()));
+        LieField {
+            a,
+            b,
+            c,
+            lift: Lift::Squares,
+            quadratic,
+        }
+    }
+
+    /// The matrix `A`.
+    pub fn a(&self) -> &Mat3<T> {
+        &self.a
+    }
+    /// The matrix `B`.
+    pub fn b(&self) -> &Mat3<T> {
+        &self.b
+    }
+    /// The matrix `C` (part of `H`; it does not enter the 3-D field under [`Lift::Squares`]).
+    pub fn c(&self) -> &Mat3<T> {
+        &self.c
+    }
+}
+
+#[inline(always)]
+fn mat_vec<T: Scalar>(m: &Mat3<T>, p: &Vec3<T>) -> Vec3<T> {
+    Vec3::new(m[0].dot(p), m[1].dot(p), m[2].dot(p))
+}
+
+/// `m p` for a dual point and plain matrix: each entry scales both dual components.
+#[inline(always)]
+fn mat_vec_dual<T: Scalar>(m: &Mat3<T>, p: &Vec3<Dual<T>>) -> Vec3<Dual<T>> {
+    let row = |r: &Vec3<T>| {
+        p.x.clone().scale(&r.x) + p.y.clone().scale(&r.y) + p.z.clone().scale(&r.z)
+    };
+    Vec3::new(row(&m[0]), row(&m[1]), row(&m[2]))
+}
+
+impl<T: Scalar> NormalField<T> for LieField<T> {
+    #[inline]
+    fn normal(&self, p: &Vec3<T>) -> Vec3<T> {
+        let v = mat_vec(&self.a, p);
+        if self.quadratic {
+            &v + &mat_vec(&self.b, &self.lift.lower(p))
+        } else {
+            v
+        }
+    }
+
+    #[inline]
+    fn normal_and_jvp(&self, p: &Vec3<T>, w: &Vec3<T>) -> (Vec3<T>, Vec3<T>) {
+        let pd = Vec3::new(
+            Dual::new(p.x.clone(), w.x.clone()),
+            Dual::new(p.y.clone(), w.y.clone()),
+            Dual::new(p.z.clone(), w.z.clone()),
+        );
+        let mut v = mat_vec_dual(&self.a, &pd);
+        if self.quadratic {
+            v = &v + &mat_vec_dual(&self.b, &self.lift.lower(&pd));
+        }
+        (
+            Vec3::new(v.x.re, v.y.re, v.z.re),
+            Vec3::new(v.x.eps, v.y.eps, v.z.eps),
+        )
+    }
+}
+
+/// A field given by a closure over dual numbers, so that one closure yields both the value
+/// and the Jacobian-vector product.
+///
+/// ```
+/// use liemesh::model::{FnField, NormalField};
+/// use liemesh::scalar::{Dual, Vec3};
+/// // A torus-like quartic's gradient, written once for Dual<f64>.
+/// let field = FnField::new(|p: &Vec3<Dual<f64>>| {
+///     let r2 = p.norm_squared();
+///     p.scale(&r2)
+/// });
+/// let (v, jw) = field.normal_and_jvp(&Vec3::new(1.0, 0.0, 0.0), &Vec3::new(1.0, 0.0, 0.0));
+/// assert_eq!((v.x, jw.x), (1.0, 3.0));
+/// ```
+#[derive(Clone, Copy, Debug)]
+pub struct FnField<F>(pub F);
+
+impl<F> FnField<F> {
+    /// Wraps a closure `Fn(&Vec3<Dual<T>>) -> Vec3<Dual<T>>`.
+    pub fn new(f: F) -> Self {
+        FnField(f)
+    }
+}
+
+impl<T: Scalar, F: Fn(&Vec3<Dual<T>>) -> Vec3<Dual<T>>> NormalField<T> for FnField<F> {
+    fn normal(&self, p: &Vec3<T>) -> Vec3<T> {
+        let v = (self.0)(&p.map(|x| Dual::constant(x.clone())));
+        v.map(|d| d.re.clone())
+    }
+    fn normal_and_jvp(&self, p: &Vec3<T>, w: &Vec3<T>) -> (Vec3<T>, Vec3<T>) {
+        let pd = Vec3::new(
+            Dual::new(p.x.clone(), w.x.clone()),
+            Dual::new(p.y.clone(), w.y.clone()),
+            Dual::new(p.z.clone(), w.z.clone()),
+        );
+        let v = (self.0)(&pd);
+        (v.map(|d| d.re.clone()), v.map(|d| d.eps.clone()))
+    }
+}
+
+/// The full Jacobian `J_v(p)` (rows = components of `v`) by three JVPs.
+pub fn jacobian<T: Scalar, F: NormalField<T> + ?Sized>(field: &F, p: &Vec3<T>) -> Mat3<T> {
+    let e = |i: usize| {
+        let mut v = Vec3::zero();
+        match i {
+            0 => v.x = T::one(),
+            1 => v.y = T::one(),
+            _ => v.z = T::one(),
+        }
+        field.normal_and_jvp(p, &v).1
+    };
+    let (c0, c1, c2) = (e(0), e(1), e(2));
+    [
+        Vec3::new(c0.x.clone(), c1.x.clone(), c2.x.clone()),
+        Vec3::new(c0.y.clone(), c1.y.clone(), c2.y.clone()),
+        Vec3::new(c0.z, c1.z, c2.z),
+    ]
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn jvp_matches_the_closed_form_derivative() {
+        let inv = Invariant::from_numbers(&crate::preset::FIG46_INVARIANT).unwrap();
+        let f = LieField::<f64>::new(&inv);
+        let p = Vec3::new(0.3, -0.7, 0.5);
+        let w = Vec3::new(0.2, 0.1, -0.4);
+        let (_, jw) = f.normal_and_jvp(&p, &w);
+        // J w = A w + B (2 p∘w)
+        let two_pw = Vec3::new(2.0 * p.x * w.x, 2.0 * p.y * w.y, 2.0 * p.z * w.z);
+        let want = &mat_vec(f.a(), &w) + &mat_vec(f.b(), &two_pw);
+        for i in 0..3 {
+            assert!((jw[i] - want[i]).abs() < 1e-15);
+        }
+    }
+
+    #[test]
+    fn linear_invariant_gives_v_equal_a_p() {
+        let inv = Invariant::from_numbers(&[2.0, 3.0, 4.0, 0.0, 0.0, 0.0]).unwrap();
+        let f = LieField::<f64>::new(&inv);
+        let v = f.normal(&Vec3::new(1.0, 1.0, 1.0));
+        assert_eq!(v.to_f64(), [2.0, 3.0, 4.0]);
+    }
+
+    #[test]
+    fn seeded_field_differentiates_with_respect_to_an_invariant_number() {
+        let inv = Invariant::from_numbers(&[2.0, 3.0, 4.0, 0.0, 0.0, 0.0]).unwrap();
+        let f = LieField::<f64>::seeded(&inv, 1); // d/dλ2
+        let p = Vec3::new(Dual::constant(1.0), Dual::constant(5.0), Dual::constant(1.0));
+        let v = f.normal(&p);
+        assert_eq!((v.x.eps, v.y.eps, v.z.eps), (0.0, 5.0, 0.0));
+    }
+}

@@ -1,0 +1,13 @@
+//! The surface model: invariants, the matrices they build, and normal fields.
+//!
+//! An [`Invariant`] (6 numbers for a linear Lie algebra, 12 or 18 for a Hamiltonian one)
+//! builds the matrices `A`, `B`, `C` and `H = [[A, B], [C, −Aᵀ]]` of the paper's eq. 2–4.
+//! Its normal field is `v(p) = A p + B (p∘p)`: the upper block of `H ℓ(p)` with the
+//! [`Lift`] `ℓ(p) = (p, p∘p)` (see DESIGN.md §1). The mesher never sees invariants, only a
+//! [`NormalField`], so users can mesh fields of their own ([`FnField`]).
+
+mod field;
+mod invariant;
+
+pub use field::{jacobian, FnField, LieField, NormalField};
+pub use invariant::{Invariant, InvariantError, InvariantKind, Lift, Mat3};

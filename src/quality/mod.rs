@@ -1,0 +1,5 @@
+//! Measuring a mesh.
+
+mod topology;
+
+pub use topology::Topology;

@@ -1,0 +1,473 @@
+//! The fan of integral curves from `p0` (paper Steps 2, 6, 7): the sample points.
+//!
+//! Curves advance together, the one with the smallest arc length first, so that the curves
+//! alive at any moment form a front around `p0`. Neighbours on the front (in order of their
+//! chart angle θ) are compared after every step: the proposed method inserts a curve between
+//! two that drifted more than `gap` steps apart (Step 6) and ends one that came closer than
+//! `merge` steps. Every method ends a curve at the maximum radius, outside the bounding box, on
+//! a budget, at a singular point, and — when closing is on — when the new point runs into
+//! points other curves laid down far away in the chart (the surface closed up behind them).
+
+mod grid;
+
+use crate::error::MeshError;
+use crate::params::{MeshParams, Method};
+use crate::scalar::{Scalar, Vec3};
+use crate::trace::{self, StepConfig, StepLimit};
+use crate::triangulate::Provenance;
+use crate::NormalField;
+use grid::Grid;
+use std::collections::BinaryHeap;
+use std::cmp::Reverse;
+
+/// How a curve ended.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum CurveEnd {
+    /// Reached the maximum geodesic radius.
+    Radius,
+    /// Left the bounding box.
+    BoundingBox,
+    /// Ran into points of curves far away in the chart: the surface closed.
+    Collision,
+    /// Came too close to a neighbouring curve (proposed method).
+    Merge,
+    /// Met a singular point (vanishing normal, no tangent direction, non-finite value).
+    Singular,
+    /// A budget ran out.
+    Budget,
+}
+
+/// One integral curve of the fan.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Curve {
+    /// Chart angle at `p0`, radians in `[0, 2π)`.
+    pub theta: f64,
+    /// Indices of its points in order (the first is `p0` for the initial fan, the inserted
+    /// point for an inserted curve).
+    pub points: Vec<u32>,
+    /// For an inserted curve: the curve whose step triggered the insertion.
+    pub parent: Option<u32>,
+    /// How it ended.
+    pub end: CurveEnd,
+}
+
+/// Per-point record of the step that produced it.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct StepRecord {
+    /// Step length Δt that led to this point (0 for curve starts).
+    pub dt: f64,
+    /// Predicted normal-turn angle α of that step, radians (0 for curve starts).
+    pub alpha_predicted: f64,
+    /// Retries (paper) or Newton iterations (default).
+    pub iterations: u32,
+    /// Limit the step ran into.
+    pub limit: StepLimit,
+}
+
+/// The sample points of one run, in the working scalar type.
+#[derive(Clone, Debug)]
+pub struct Samples<T> {
+    /// Points; index 0 is `p0`.
+    pub points: Vec<Vec3<T>>,
+    /// Unit field normal at each point.
+    pub normals: Vec<Vec3<T>>,
+    /// Where each point came from.
+    pub provenance: Vec<Provenance>,
+    /// The step that produced each point.
+    pub steps: Vec<StepRecord>,
+    /// The curves.
+    pub curves: Vec<Curve>,
+    /// Chart frame at `p0`: `e1` (from `w00`), `e2 = n0 × e1`, `n0`.
+    pub frame: [[f64; 3]; 3],
+    /// Whether the point budget stopped the run.
+    pub hit_point_budget: bool,
+}
+
+impl<T: Scalar> Samples<T> {
+    /// Chart position `(s cos θ, s sin θ)` of point `i`.
+    pub fn chart(&self, i: usize) -> [f64; 2] {
+        let pr = &self.provenance[i];
+        [pr.s * pr.theta.cos(), pr.s * pr.theta.sin()]
+    }
+
+    /// Whether every curve ended by collision or merge (no boundary was reached):
+    /// the front closed up and the surface is closed.
+    pub fn front_closed(&self) -> bool {
+        self.curves
+            .iter()
+            .all(|c| matches!(c.end, CurveEnd::Collision | CurveEnd::Merge))
+            && self.curves.iter().any(|c| c.end == CurveEnd::Collision)
+    }
+}
+
+/// Closure test: a new point ends its curve when it is nearer than this many step lengths
+/// to a point that lies far away in the chart.
+const COLLISION_RADIUS: f64 = 0.6;
+
+struct Live<T> {
+    p: Vec3<T>,
+    carry: Vec3<T>,
+    dt: T,
+    s: f64,
+    left: u32,
+    right: u32,
+    active: bool,
+}
+
+/// Samples the surface of `field` from `params.p0` (paper Steps 2–7).
+pub fn sample<T: Scalar, F: NormalField<T>>(
+    field: &F,
+    params: &MeshParams,
+) -> Result<Samples<T>, MeshError> {
+    params.validate()?;
+    let cfg = StepConfig::<T>::new(params);
+    let p0 = Vec3::<T>::from_f64(params.p0);
+    let v0 = field.normal(&p0);
+    let Some((n0, _)) = v0.normalize() else {
+        return Err(MeshError::SingularInitialPoint {
+            p0: params.p0,
+            normal: v0.to_f64(),
+        });
+    };
+    let w00 = Vec3::<T>::from_f64(params.w00);
+    let Some(e1) = trace::project_tangent(&w00, &n0) else {
+        return Err(MeshError::DirectionParallelToNormal {
+            w00: params.w00,
+            normal: v0.to_f64(),
+        });
+    };
+    let e2 = n0.cross(&e1);
+    let frame = [e1.to_f64(), e2.to_f64(), n0.to_f64()];
+
+    let thetas: Vec<f64> = match params.method {
+        Method::Previous { curves } => (0..curves)
+            .map(|j| std::f64::consts::TAU * j as f64 / curves as f64)
+            .collect(),
+        // Step 2: first points p0 + Δt w at least Δt apart ⇔ directions at least 60° apart.
+        Method::Proposed => (0..6).map(|j| std::f64::consts::FRAC_PI_3 * j as f64).collect(),
+    };
+
+    let mut s = Sampler {
+        field,
+        params,
+        cfg,
+        out: Samples {
+            points: vec![p0.clone()],
+            normals: Vec::new(),
+            provenance: vec![Provenance {
+                curve: 0,
+                step: 0,
+                s: 0.0,
+                theta: 0.0,
+            }],
+            steps: vec![StepRecord::default()],
+            curves: Vec::new(),
+            frame,
+            hit_point_budget: false,
+        },
+        pos: vec![params.p0],
+        live: Vec::new(),
+        heap: BinaryHeap::new(),
+        grid: Grid::new(params.dt.max(1e-300)),
+    };
+    s.grid.insert(params.p0, 0);
+    let n = thetas.len() as u32;
+    for (j, &theta) in thetas.iter().enumerate() {
+        let j = j as u32;
+        let dir = e1.scale(&T::from_f64(theta.cos())).add_scaled(&T::from_f64(theta.sin()), &e2);
+        s.out.curves.push(Curve {
+            theta,
+            points: vec![0],
+            parent: None,
+            end: CurveEnd::Budget,
+        });
+        s.live.push(Live {
+            p: p0.clone(),
+            carry: dir,
+            dt: T::from_f64(params.dt),
+            s: 0.0,
+            left: (j + n - 1) % n,
+            right: (j + 1) % n,
+            active: true,
+        });
+        s.heap.push(Reverse((0.0f64.to_bits(), j)));
+    }
+    s.run();
+    let Sampler { mut out, .. } = s;
+    out.normals = out
+        .points
+        .iter()
+        .map(|p| {
+            trace::unit_normal(field, p)
+                .map(|(_, n, _)| n)
+                .unwrap_or_else(|_| Vec3::zero())
+        })
+        .collect();
+    Ok(out)
+}
+
+struct Sampler<'a, T, F> {
+    field: &'a F,
+    params: &'a MeshParams,
+    cfg: StepConfig<T>,
+    out: Samples<T>,
+    /// `f64` copies of the points for the geometric tests.
+    pos: Vec<[f64; 3]>,
+    live: Vec<Live<T>>,
+    heap: BinaryHeap<Reverse<(u64, u32)>>,
+    grid: Grid,
+}
+
+fn dist(a: [f64; 3], b: [f64; 3]) -> f64 {
+    ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2) + (a[2] - b[2]).powi(2)).sqrt()
+}
+
+fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+}
+
+fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+
+impl<T: Scalar, F: NormalField<T>> Sampler<'_, T, F> {
+    fn run(&mut self) {
+        let budget = &self.params.budget;
+        // Every pass either adds a point or ends a curve, so this bound is never the binding
+        // one; it is here so that the loop visibly terminates.
+        let max_passes = budget.max_points + 2 * budget.max_curves + 16;
+        for _ in 0..max_passes {
+            let Some(Reverse((_, c))) = self.heap.pop() else {
+                return;
+            };
+            if let Some(end) = self.advance(c) {
+                self.end_curve(c, end);
+            } else {
+                let s = self.live[c as usize].s;
+                self.heap.push(Reverse((s.to_bits(), c)));
+            }
+        }
+        // Budget exhausted: end what is still running.
+        while let Some(Reverse((_, c))) = self.heap.pop() {
+            self.end_curve(c, CurveEnd::Budget);
+        }
+    }
+
+    fn end_curve(&mut self, c: u32, end: CurveEnd) {
+        let (l, r) = (self.live[c as usize].left, self.live[c as usize].right);
+        self.live[c as usize].active = false;
+        self.out.curves[c as usize].end = end;
+        if l != c {
+            self.live[l as usize].right = r;
+            self.live[r as usize].left = l;
+        }
+    }
+
+    /// One step of curve `c`; `Some(reason)` ends the curve.
+    fn advance(&mut self, c: u32) -> Option<CurveEnd> {
+        let ci = c as usize;
+        let budget = self.params.budget;
+        if self.out.points.len() >= budget.max_points {
+            self.out.hit_point_budget = true;
+            return Some(CurveEnd::Budget);
+        }
+        if self.out.curves[ci].points.len() > budget.max_steps_per_curve {
+            return Some(CurveEnd::Budget);
+        }
+        let live = &self.live[ci];
+        let step = match trace::step(self.field, &self.cfg, &live.p, &live.carry, &live.dt) {
+            Ok(s) => s,
+            Err(_) => return Some(CurveEnd::Singular),
+        };
+        let len = step.dt.to_f64();
+        let q = step.point.to_f64();
+        let s_new = live.s + len;
+        if s_new > self.params.terminal.max_radius {
+            return Some(CurveEnd::Radius);
+        }
+        let bb = self.params.terminal.bounding_box;
+        if q.iter().any(|x| x.abs() > bb) {
+            return Some(CurveEnd::BoundingBox);
+        }
+        let theta = self.out.curves[ci].theta;
+        let chart_q = [s_new * theta.cos(), s_new * theta.sin()];
+        if self.params.terminal.close && self.collides(q, chart_q, len) {
+            return Some(CurveEnd::Collision);
+        }
+        let proposed = self.params.method == Method::Proposed;
+        let (left, right) = (live.left, live.right);
+        if proposed && self.params.merge > 0.0 {
+            for k in [right, left] {
+                if k != c && self.lateral_gap(k, q).0 < self.params.merge * len {
+                    return Some(CurveEnd::Merge);
+                }
+            }
+        }
+
+        // Accept.
+        let index = self.out.points.len() as u32;
+        let step_index = self.out.curves[ci].points.len() as u32;
+        self.out.points.push(step.point.clone());
+        self.out.provenance.push(Provenance {
+            curve: c,
+            step: step_index,
+            s: s_new,
+            theta,
+        });
+        self.out.steps.push(StepRecord {
+            dt: len,
+            alpha_predicted: step.alpha_predicted,
+            iterations: step.iterations,
+            limit: step.limit,
+        });
+        self.out.curves[ci].points.push(index);
+        self.pos.push(q);
+        self.grid.insert(q, index);
+        let live = &mut self.live[ci];
+        live.p = step.point;
+        live.carry = step.carry;
+        live.dt = step.dt;
+        live.s = s_new;
+
+        if proposed {
+            for side_right in [true, false] {
+                let live = &self.live[ci];
+                let k = if side_right { live.right } else { live.left };
+                if k == c || self.out.curves.len() >= budget.max_curves {
+                    continue;
+                }
+                let (gap, target, s_target) = self.lateral_gap(k, q);
+                if gap > self.params.gap * len {
+                    self.insert_between(c, k, side_right, q, target, s_target, len);
+                }
+            }
+        }
+        None
+    }
+
+    /// The closure test: a point nearer than `COLLISION_RADIUS` steps whose chart position is
+    /// much farther away than its distance in space, i.e. the surface came back on itself.
+    fn collides(&self, q: [f64; 3], chart_q: [f64; 2], len: f64) -> bool {
+        let radius = COLLISION_RADIUS * len;
+        let mut hit = false;
+        self.grid.for_each_near(q, radius, |j| {
+            if hit {
+                return;
+            }
+            let d = dist(q, self.pos[j as usize]);
+            if d < radius {
+                let cj = self.out.chart(j as usize);
+                let dc = ((cj[0] - chart_q[0]).powi(2) + (cj[1] - chart_q[1]).powi(2)).sqrt();
+                if dc > 2.0 * d + len {
+                    hit = true;
+                }
+            }
+        });
+        hit
+    }
+
+    /// Distance from `q` to curve `k` across it: to the line of its last segment (so that a
+    /// neighbour one step behind does not look farther away than it is), or to its only point.
+    /// Also returns the foot point and its arc length.
+    fn lateral_gap(&self, k: u32, q: [f64; 3]) -> (f64, [f64; 3], f64) {
+        let pts = &self.out.curves[k as usize].points;
+        let last = *pts.last().expect("curves start with one point") as usize;
+        let x1 = self.pos[last];
+        let s1 = self.out.provenance[last].s;
+        if pts.len() < 2 {
+            return (dist(q, x1), x1, s1);
+        }
+        let prev = pts[pts.len() - 2] as usize;
+        let x0 = self.pos[prev];
+        let t = sub(x1, x0);
+        let tt = dot(t, t);
+        if tt <= 0.0 {
+            return (dist(q, x1), x1, s1);
+        }
+        let u = dot(sub(q, x1), t) / tt;
+        let foot = [x1[0] + u * t[0], x1[1] + u * t[1], x1[2] + u * t[2]];
+        let s_foot = s1 + u * tt.sqrt();
+        (dist(q, foot), foot, s_foot)
+    }
+
+    /// Step 6: a new curve between `c` (which just stepped to `q`) and its neighbour `k`.
+    #[allow(clippy::too_many_arguments)]
+    fn insert_between(
+        &mut self,
+        c: u32,
+        k: u32,
+        k_is_right: bool,
+        q: [f64; 3],
+        target: [f64; 3],
+        s_target: f64,
+        len: f64,
+    ) {
+        use std::f64::consts::TAU;
+        let (tc, tk) = (self.out.curves[c as usize].theta, self.out.curves[k as usize].theta);
+        // Angular distance going counter-clockwise from c to k (right) or from k to c (left).
+        let span = if k_is_right {
+            (tk - tc).rem_euclid(TAU)
+        } else {
+            (tc - tk).rem_euclid(TAU)
+        };
+        if span < 1e-9 {
+            return;
+        }
+        let theta = if k_is_right { tc + span / 2.0 } else { tc - span / 2.0 }.rem_euclid(TAU);
+        let d = sub(target, q);
+        let half = 0.5 * dot(d, d).sqrt();
+        let live_c = &self.live[c as usize];
+        let start = match trace::step_fixed(
+            self.field,
+            &self.cfg,
+            &live_c.p,
+            &Vec3::from_f64(d),
+            &T::from_f64(half),
+        ) {
+            Ok(p) => p,
+            Err(_) => return,
+        };
+        let start_f = start.to_f64();
+        let s = 0.5 * (self.live[c as usize].s + s_target);
+        let chart = [s * theta.cos(), s * theta.sin()];
+        if self.params.terminal.close && self.collides(start_f, chart, len) {
+            return;
+        }
+        let carry = (&self.live[c as usize].carry + &self.live[k as usize].carry)
+            .normalize()
+            .map(|(u, _)| u)
+            .unwrap_or_else(|| self.live[c as usize].carry.clone());
+        let id = self.out.curves.len() as u32;
+        let index = self.out.points.len() as u32;
+        self.out.points.push(start.clone());
+        self.out.provenance.push(Provenance {
+            curve: id,
+            step: 0,
+            s,
+            theta,
+        });
+        self.out.steps.push(StepRecord::default());
+        self.out.curves.push(Curve {
+            theta,
+            points: vec![index],
+            parent: Some(c),
+            end: CurveEnd::Budget,
+        });
+        self.pos.push(start_f);
+        self.grid.insert(start_f, index);
+        let (left, right) = if k_is_right { (c, k) } else { (k, c) };
+        self.live.push(Live {
+            p: start,
+            carry,
+            dt: self.live[c as usize].dt.clone(),
+            s,
+            left,
+            right,
+            active: true,
+        });
+        self.live[left as usize].right = id;
+        self.live[right as usize].left = id;
+        self.heap.push(Reverse((s.to_bits(), id)));
+    }
+}

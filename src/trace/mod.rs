@@ -1,0 +1,394 @@
+//! Tracing one integral curve: one adaptive step at a time (paper Steps 3–5).
+//!
+//! A step at `p_i` with incoming direction `w_{i-1}`:
+//! 1. `v_i = v(p_i)`, `n_i = v_i/|v_i|`;
+//! 2. `w_i = normalize(w_{i-1} − (n_i·w_{i-1}) n_i)` (eq. 7);
+//! 3. one forward-mode JVP `J_v(p_i) w_i`, reused for every trial Δt;
+//! 4. the predicted normal `v_i + Δt J_v w_i` (eq. 8–9) and its angle α to `v_i` choose Δt;
+//! 5. the new point: `p_i + Δt w_i` in [`Mode::Paper`] (eq. 6), or a drift-free chord of
+//!    length Δt in [`Mode::Default`].
+
+use crate::params::{MeshParams, Mode};
+use crate::scalar::{self, Scalar, Vec3};
+use crate::NormalField;
+
+/// Step control converted once to the working scalar type.
+#[derive(Clone, Debug)]
+pub struct StepConfig<T> {
+    mode: Mode,
+    beta_min: T,
+    beta_max: T,
+    tan_target: T,
+    grow: T,
+    shrink: T,
+    dt_min: T,
+    dt_max: T,
+    max_retries: usize,
+}
+
+impl<T: Scalar> StepConfig<T> {
+    /// Reads the step parameters (assumed validated).
+    pub fn new(params: &MeshParams) -> Self {
+        StepConfig {
+            mode: params.mode,
+            beta_min: T::from_f64(params.beta_min),
+            beta_max: T::from_f64(params.beta_max),
+            tan_target: T::from_f64(0.5 * (params.beta_min + params.beta_max)).tan(),
+            grow: T::from_f64(params.grow),
+            shrink: T::from_f64(params.shrink),
+            dt_min: T::from_f64(params.dt_min),
+            dt_max: T::from_f64(params.dt_max),
+            max_retries: params.budget.max_retries,
+        }
+    }
+
+    /// The step mode.
+    pub fn mode(&self) -> Mode {
+        self.mode
+    }
+}
+
+/// Why a step could not be taken: the curve ends there.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum StepStop {
+    /// `v(p)` is zero or not finite: a singular point.
+    SingularNormal,
+    /// The carried direction is parallel to the normal, so it has no tangent part.
+    NoTangent,
+    /// The new point is not finite.
+    NonFinite,
+}
+
+/// Which limit, if any, an accepted step ran into.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum StepLimit {
+    /// α landed inside `[β_min, β_max]`.
+    #[default]
+    None,
+    /// Δt hit `dt_min` or `dt_max`, so α may lie outside the band.
+    Clamped,
+    /// The retry (paper) or Newton (default) budget ran out.
+    Budget,
+}
+
+/// An accepted step.
+#[derive(Clone, Debug)]
+pub struct Step<T> {
+    /// The new point `p_{i+1}`.
+    pub point: Vec3<T>,
+    /// The direction handed to the next step (projected there by eq. 7).
+    pub carry: Vec3<T>,
+    /// The tangent `w_i` used at `p_i`.
+    pub tangent: Vec3<T>,
+    /// The unit normal `n_i` at `p_i`.
+    pub normal: Vec3<T>,
+    /// The Δt used: the step length.
+    pub dt: T,
+    /// The predicted normal-turn angle α of the accepted Δt, radians.
+    pub alpha_predicted: f64,
+    /// How many Δt retries (paper) or Newton iterations (default) the step took.
+    pub iterations: u32,
+    /// A limit the step ran into.
+    pub limit: StepLimit,
+}
+
+/// The unit normal at `p`, or [`StepStop::SingularNormal`].
+#[inline]
+pub fn unit_normal<T: Scalar, F: NormalField<T>>(
+    field: &F,
+    p: &Vec3<T>,
+) -> Result<(Vec3<T>, Vec3<T>, T), StepStop> {
+    let v = field.normal(p);
+    match v.normalize() {
+        Some((n, len)) => Ok((v, n, len)),
+        None => Err(StepStop::SingularNormal),
+    }
+}
+
+/// `normalize(w − (n·w) n)`: eq. 7, the tangent part of `w`.
+#[inline]
+pub fn project_tangent<T: Scalar>(w: &Vec3<T>, n: &Vec3<T>) -> Option<Vec3<T>> {
+    let k = -n.dot(w);
+    let t = w.add_scaled(&k, n);
+    // A tangent part below a few ulps of |w| is noise: the direction was along the normal.
+    let tiny = T::from_f64(64.0 * T::unit_roundoff());
+    let (u, len) = t.normalize()?;
+    if len <= tiny * w.norm() {
+        None
+    } else {
+        Some(u)
+    }
+}
+
+/// Takes one adaptive step from `p` (paper Steps 3–5), starting from the step size `dt`.
+pub fn step<T: Scalar, F: NormalField<T>>(
+    field: &F,
+    cfg: &StepConfig<T>,
+    p: &Vec3<T>,
+    w_prev: &Vec3<T>,
+    dt: &T,
+) -> Result<Step<T>, StepStop> {
+    let (v, n, vlen) = unit_normal(field, p)?;
+    let w = project_tangent(w_prev, &n).ok_or(StepStop::NoTangent)?;
+    // One JVP per step, reused by every trial Δt below.
+    let (_, jw) = field.normal_and_jvp(p, &w);
+    if !jw.is_finite() {
+        return Err(StepStop::NonFinite);
+    }
+    let angle = |dt: &T| v.angle_to(&v.add_scaled(dt, &jw));
+
+    match cfg.mode {
+        Mode::Paper => {
+            let mut dt = dt.clone();
+            let mut limit = StepLimit::Budget;
+            let mut iterations = 0;
+            let mut alpha = angle(&dt);
+            for _ in 0..=cfg.max_retries {
+                if alpha < cfg.beta_min {
+                    if dt >= cfg.dt_max {
+                        limit = StepLimit::Clamped;
+                        break;
+                    }
+                    dt = scalar::min(dt * cfg.grow.clone(), cfg.dt_max.clone());
+                } else if alpha > cfg.beta_max {
+                    if dt <= cfg.dt_min {
+                        limit = StepLimit::Clamped;
+                        break;
+                    }
+                    dt = scalar::max(dt * cfg.shrink.clone(), cfg.dt_min.clone());
+                } else {
+                    limit = StepLimit::None;
+                    break;
+                }
+                iterations += 1;
+                alpha = angle(&dt);
+            }
+            let point = p.add_scaled(&dt, &w);
+            if !point.is_finite() {
+                return Err(StepStop::NonFinite);
+            }
+            Ok(Step {
+                point,
+                carry: w.clone(),
+                tangent: w,
+                normal: n,
+                alpha_predicted: alpha.to_f64(),
+                dt,
+                iterations,
+                limit,
+            })
+        }
+        Mode::Default => {
+            // Closed form for α(Δt) = α*: with J w = a n + b e (e ⊥ n, b ≥ 0),
+            // tan α = Δt b / (|v| + Δt a), so Δt = |v| tan α* / (b − a tan α*).
+            let a = jw.dot(&n);
+            let b = jw.add_scaled(&(-a.clone()), &n).norm();
+            let denom = b - a * cfg.tan_target.clone();
+            let mut limit = StepLimit::None;
+            let mut dt = if denom > T::zero() {
+                vlen.clone() * cfg.tan_target.clone() / denom
+            } else {
+                cfg.dt_max.clone()
+            };
+            if !(dt.is_finite()) || dt > cfg.dt_max {
+                dt = cfg.dt_max.clone();
+                limit = StepLimit::Clamped;
+            } else if dt < cfg.dt_min {
+                dt = cfg.dt_min.clone();
+                limit = StepLimit::Clamped;
+            }
+            let alpha = angle(&dt);
+            if limit == StepLimit::None && (alpha < cfg.beta_min || alpha > cfg.beta_max) {
+                limit = StepLimit::Clamped;
+            }
+            let kappa = w.dot(&jw) / vlen.clone();
+            let chord = drift_free_chord(field, cfg, p, &v, &n, &w, &dt, &kappa)?;
+            if chord.limited && limit == StepLimit::None {
+                limit = StepLimit::Budget;
+            }
+            // The end tangent of a circular arc is the start tangent reflected in the chord.
+            let cw = chord.direction.dot(&w);
+            let carry = chord
+                .direction
+                .scale(&(cw.clone() + cw))
+                .add_scaled(&-T::one(), &w);
+            Ok(Step {
+                point: chord.point,
+                carry,
+                tangent: w,
+                normal: n,
+                alpha_predicted: alpha.to_f64(),
+                dt,
+                iterations: chord.iterations,
+                limit,
+            })
+        }
+    }
+}
+
+/// A step of fixed length from `p` along the tangent part of `dir`, with the same rule as
+/// the mode's steps (used to place the first point of an inserted curve on the surface).
+pub fn step_fixed<T: Scalar, F: NormalField<T>>(
+    field: &F,
+    cfg: &StepConfig<T>,
+    p: &Vec3<T>,
+    dir: &Vec3<T>,
+    length: &T,
+) -> Result<Vec3<T>, StepStop> {
+    let (v, n, vlen) = unit_normal(field, p)?;
+    let w = project_tangent(dir, &n).ok_or(StepStop::NoTangent)?;
+    match cfg.mode {
+        Mode::Paper => {
+            let q = p.add_scaled(length, &w);
+            if q.is_finite() {
+                Ok(q)
+            } else {
+                Err(StepStop::NonFinite)
+            }
+        }
+        Mode::Default => {
+            let (_, jw) = field.normal_and_jvp(p, &w);
+            let kappa = w.dot(&jw) / vlen;
+            Ok(drift_free_chord(field, cfg, p, &v, &n, &w, length, &kappa)?.point)
+        }
+    }
+}
+
+struct Chord<T> {
+    point: Vec3<T>,
+    direction: Vec3<T>,
+    iterations: u32,
+    limited: bool,
+}
+
+/// The chord `p + L c`, `c = cos φ w + sin φ n`, with `φ` solving
+/// `G(φ) = (v(p) + 4 v(p + L c/2) + v(p + L c)) · c = 0` by Newton's method.
+///
+/// `G = 0` says Simpson's rule for `∫ v·dp` along the chord vanishes. When `v = ∇F` with `F`
+/// a polynomial of degree ≤ 3 (every integrable field of this model), Simpson's rule is
+/// exact, so `F(p + L c) = F(p)`: the step stays on the level set. `G'(φ)` comes from two
+/// JVPs through dual numbers.
+#[allow(clippy::too_many_arguments)]
+fn drift_free_chord<T: Scalar, F: NormalField<T>>(
+    field: &F,
+    cfg: &StepConfig<T>,
+    p: &Vec3<T>,
+    v0: &Vec3<T>,
+    n: &Vec3<T>,
+    w: &Vec3<T>,
+    length: &T,
+    kappa: &T,
+) -> Result<Chord<T>, StepStop> {
+    let half = T::from_f64(0.5);
+    let four = T::from_f64(4.0);
+    let half_len = length.clone() * half.clone();
+    // Initial guess: the chord of the osculating circle, φ ≈ −κL/2.
+    let mut phi = -(kappa.clone() * half_len.clone());
+    let tol = T::from_f64(16.0 * T::unit_roundoff());
+    let newton_budget = cfg.max_retries.clamp(4, 64);
+    let mut iterations = 0;
+    let mut converged = false;
+    for _ in 0..newton_budget {
+        iterations += 1;
+        let (s, c) = (phi.sin(), phi.cos());
+        let dir = w.scale(&c).add_scaled(&s, n);
+        let perp = n.scale(&c).add_scaled(&-s, w);
+        let pm = p.add_scaled(&half_len, &dir);
+        let p1 = p.add_scaled(length, &dir);
+        let (vm, jm) = field.normal_and_jvp(&pm, &perp);
+        let (v1, j1) = field.normal_and_jvp(&p1, &perp);
+        let sum = &(v0 + &vm.scale(&four)) + &v1;
+        let g = sum.dot(&dir);
+        // d/dφ: the points move by (L/2) c⊥ and L c⊥.
+        let dsum = &jm.scale(&(four.clone() * half_len.clone())) + &j1.scale(length);
+        let dg = sum.dot(&perp) + dsum.dot(&dir);
+        if !(g.is_finite() && dg.is_finite()) || dg.is_zero() {
+            return Err(StepStop::NonFinite);
+        }
+        let delta = g / dg;
+        phi -= delta.clone();
+        if delta.abs() <= tol.clone() * scalar::max(T::one(), phi.abs()) {
+            converged = true;
+            break;
+        }
+    }
+    let (s, c) = (phi.sin(), phi.cos());
+    let direction = w.scale(&c).add_scaled(&s, n);
+    let point = p.add_scaled(length, &direction);
+    if !point.is_finite() {
+        return Err(StepStop::NonFinite);
+    }
+    Ok(Chord {
+        point,
+        direction,
+        iterations,
+        limited: !converged,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::model::{Invariant, LieField};
+    use crate::preset::Preset;
+
+    fn sphere() -> LieField<f64> {
+        LieField::new(&Invariant::from_numbers(&[1.0, 1.0, 1.0, 0.0, 0.0, 0.0]).unwrap())
+    }
+
+    #[test]
+    fn paper_step_lands_inside_the_band_and_drifts_outward() {
+        let params = MeshParams {
+            mode: Mode::Paper,
+            ..Preset::Fig3.params()
+        };
+        let cfg = StepConfig::<f64>::new(&params);
+        let p = Vec3::new(0.0, 0.0, 1.0);
+        let s = step(&sphere(), &cfg, &p, &Vec3::new(1.0, 0.0, 0.0), &params.dt).unwrap();
+        assert_eq!(s.limit, StepLimit::None);
+        assert!(s.alpha_predicted >= params.beta_min && s.alpha_predicted <= params.beta_max);
+        // Explicit Euler leaves the sphere by 1 + Δt²/2 to first order.
+        let r = s.point.norm();
+        assert!(r > 1.0 + 0.4 * s.dt * s.dt, "{r}");
+    }
+
+    #[test]
+    fn default_step_stays_on_the_sphere_to_rounding() {
+        let params = Preset::Fig3.params();
+        let cfg = StepConfig::<f64>::new(&params);
+        let mut p = Vec3::new(0.0, 0.0, 1.0);
+        let mut w = Vec3::new(1.0, 0.0, 0.0);
+        for _ in 0..100 {
+            let s = step(&sphere(), &cfg, &p, &w, &params.dt).unwrap();
+            p = s.point;
+            w = s.carry;
+        }
+        assert!((p.norm() - 1.0).abs() < 1e-14, "{}", p.norm() - 1.0);
+    }
+
+    #[test]
+    fn default_step_stays_on_an_ellipsoid_to_rounding() {
+        let inv = Invariant::from_numbers(&[1.0, 4.0, 16.0, 0.0, 0.0, 0.0]).unwrap();
+        let f = LieField::<f64>::new(&inv);
+        let pot = inv.potential().unwrap();
+        let params = Preset::Fig3.params();
+        let cfg = StepConfig::<f64>::new(&params);
+        let mut p = Vec3::new(0.6, 0.3, 0.1);
+        let f0 = pot(p.to_f64());
+        let mut w = Vec3::new(0.0, 1.0, 0.0);
+        for _ in 0..200 {
+            let s = step(&f, &cfg, &p, &w, &params.dt).unwrap();
+            p = s.point;
+            w = s.carry;
+        }
+        assert!(((pot(p.to_f64()) - f0) / f0).abs() < 1e-13);
+    }
+
+    #[test]
+    fn a_vanishing_normal_stops_the_curve() {
+        let params = Preset::Fig3.params();
+        let cfg = StepConfig::<f64>::new(&params);
+        let r = step(&sphere(), &cfg, &Vec3::zero(), &Vec3::new(1.0, 0.0, 0.0), &0.1);
+        assert_eq!(r.unwrap_err(), StepStop::SingularNormal);
+    }
+}

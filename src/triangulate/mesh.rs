@@ -1,0 +1,46 @@
+//! The finished mesh: what every stage after triangulation reads.
+
+use serde::{Deserialize, Serialize};
+
+/// Where a vertex came from in the sampling stage.
+///
+/// `curve` and `step` identify the integral curve and the accepted step on it
+/// (`step == 0` is the curve's first point; the initial point `p0` is curve 0,
+/// step 0). `s` is the arc length along the polyline of the curve measured from
+/// `p0` (inserted curves inherit the arc length of the point they start from),
+/// and `theta` is the curve's angle at `p0` in the chart, in radians.
+/// Vertices added to close a surface carry `curve == u32::MAX`.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct Provenance {
+    /// Index of the integral curve the vertex lies on.
+    pub curve: u32,
+    /// Index of the accepted step on that curve (0 = the curve's first point).
+    pub step: u32,
+    /// Arc length from `p0` along the sampled curves.
+    pub s: f64,
+    /// The curve's angle at `p0` (chart angle), radians.
+    pub theta: f64,
+}
+
+impl Provenance {
+    /// Curve id given to vertices that were added to close a surface.
+    pub const CLOSING_CURVE: u32 = u32::MAX;
+}
+
+/// A triangle mesh in `f64`: vertices, unit field normals at the vertices,
+/// counter-clockwise triangles (seen from the side the field normal points to)
+/// and per-vertex [`Provenance`].
+///
+/// All four vectors describing vertices have the same length, and every index
+/// in `triangles` is smaller than it.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct Mesh {
+    /// Vertex positions.
+    pub vertices: Vec<[f64; 3]>,
+    /// Unit normal of the field at each vertex.
+    pub normals: Vec<[f64; 3]>,
+    /// Triangles as vertex index triples, counter-clockwise about the field normal.
+    pub triangles: Vec<[u32; 3]>,
+    /// Where each vertex came from.
+    pub provenance: Vec<Provenance>,
+}

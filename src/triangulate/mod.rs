@@ -1,0 +1,379 @@
+//! Triangulation of the samples (the paper's second "Step 7").
+//!
+//! 1. **Chart 1**: every sample at its geodesic polar position `(s cos θ, s sin θ)`, a
+//!    constrained Delaunay triangulation (spade) whose constraint is the front polygon — the
+//!    curves' last points in order of θ — and only the triangles inside it.
+//! 2. **Chart 2** (closed surfaces): the front polygon bounds the hole the curves left on the
+//!    far side. It is projected onto the plane across the mean normal of its vertices and
+//!    triangulated there with the polygon as constraints, sharing the polygon's vertices, so
+//!    the two charts are stitched edge to edge and the mesh is watertight.
+//! 3. Triangles are counter-clockwise in both charts, whose frames are right-handed about the
+//!    field normal: every triangle is oriented with the field normal.
+
+mod mesh;
+
+pub use mesh::{Mesh, Provenance};
+
+use crate::error::MeshError;
+use crate::sample::{CurveEnd, Samples};
+use crate::scalar::Scalar;
+use spade::{ConstrainedDelaunayTriangulation, HasPosition, Point2, Triangulation as _};
+
+/// The chart-1 triangulation, kept for audits (empty-circumcircle checks, snapshots).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct ChartTriangulation {
+    /// Chart position of every sample point (by sample index).
+    pub chart: Vec<[f64; 2]>,
+    /// Chart-1 triangles (sample indices, counter-clockwise in the chart).
+    pub triangles: Vec<[u32; 3]>,
+    /// The front polygon (sample indices, counter-clockwise in the chart); its edges are the
+    /// constraints.
+    pub front: Vec<u32>,
+    /// Triangles of chart 2 that close the surface (sample indices).
+    pub closing: Vec<[u32; 3]>,
+}
+
+#[derive(Clone, Copy, Debug)]
+struct ChartVertex {
+    position: Point2<f64>,
+    index: u32,
+}
+
+impl HasPosition for ChartVertex {
+    type Scalar = f64;
+    fn position(&self) -> Point2<f64> {
+        self.position
+    }
+}
+
+/// Triangulates `samples` into a mesh (and returns the chart triangulation beside it).
+pub fn triangulate<T: Scalar>(
+    samples: &Samples<T>,
+    close: bool,
+) -> Result<(Mesh, ChartTriangulation), MeshError> {
+    let n = samples.points.len();
+    if n < 3 {
+        return Err(MeshError::Triangulation(format!(
+            "only {n} sample point(s); the curves ended right away (check p0, Δt and the terminal conditions)"
+        )));
+    }
+    let chart: Vec<[f64; 2]> = (0..n).map(|i| samples.chart(i)).collect();
+    let front = front_polygon(samples, &chart);
+    let pos: Vec<[f64; 3]> = samples.points.iter().map(|p| p.to_f64()).collect();
+
+    let triangles = chart_triangles(&chart, &front)?;
+    let mut closing = Vec::new();
+    if close && samples.front_closed() && front.len() >= 3 {
+        let normals: Vec<[f64; 3]> = front
+            .iter()
+            .map(|&i| samples.normals[i as usize].to_f64())
+            .collect();
+        closing = close_hole(&front, &pos, &normals);
+    }
+
+    let mut all = triangles.clone();
+    all.extend_from_slice(&closing);
+    let mesh = assemble(samples, &pos, &all);
+    Ok((
+        mesh,
+        ChartTriangulation {
+            chart,
+            triangles,
+            front,
+            closing,
+        },
+    ))
+}
+
+/// The front polygon: each curve's last point in order of θ, without the ends of merged
+/// curves that lie inside the polygon of their neighbours (those curves stopped between two
+/// that went on, and the region beyond their end belongs to the mesh).
+fn front_polygon<T: Scalar>(samples: &Samples<T>, chart: &[[f64; 2]]) -> Vec<u32> {
+    let mut order: Vec<usize> = (0..samples.curves.len()).collect();
+    order.sort_by(|&a, &b| samples.curves[a].theta.total_cmp(&samples.curves[b].theta));
+    let mut poly: Vec<(u32, bool)> = order
+        .iter()
+        .map(|&c| {
+            let curve = &samples.curves[c];
+            (*curve.points.last().unwrap(), curve.end == CurveEnd::Merge)
+        })
+        .collect();
+    // Remove merged ends inside the triangle (origin, previous, next), until none is left.
+    for _ in 0..poly.len() {
+        let m = poly.len();
+        if m <= 3 {
+            break;
+        }
+        let mut keep = Vec::with_capacity(m);
+        let mut removed = false;
+        for i in 0..m {
+            let (v, merged) = poly[i];
+            if merged && !removed {
+                let prev = chart[poly[(i + m - 1) % m].0 as usize];
+                let next = chart[poly[(i + 1) % m].0 as usize];
+                let here = chart[v as usize];
+                // Inside the wedge triangle ⇔ on the origin's side of prev→next.
+                if cross2(sub2(next, prev), sub2(here, prev)) > 0.0
+                    && wedge_span(prev, next) < std::f64::consts::PI
+                {
+                    removed = true;
+                    continue;
+                }
+            }
+            keep.push(poly[i]);
+        }
+        if !removed {
+            break;
+        }
+        poly = keep;
+    }
+    let mut front: Vec<u32> = poly.into_iter().map(|(v, _)| v).collect();
+    front.dedup();
+    if front.len() > 1 && front.first() == front.last() {
+        front.pop();
+    }
+    front
+}
+
+fn sub2(a: [f64; 2], b: [f64; 2]) -> [f64; 2] {
+    [a[0] - b[0], a[1] - b[1]]
+}
+
+fn cross2(a: [f64; 2], b: [f64; 2]) -> f64 {
+    a[0] * b[1] - a[1] * b[0]
+}
+
+/// Counter-clockwise angle from the direction of `a` to that of `b`, in `[0, 2π)`.
+fn wedge_span(a: [f64; 2], b: [f64; 2]) -> f64 {
+    (b[1].atan2(b[0]) - a[1].atan2(a[0])).rem_euclid(std::f64::consts::TAU)
+}
+
+/// Constrained Delaunay triangulation of the chart points, keeping the triangles inside the
+/// front polygon.
+fn chart_triangles(chart: &[[f64; 2]], front: &[u32]) -> Result<Vec<[u32; 3]>, MeshError> {
+    let vertices: Vec<ChartVertex> = chart
+        .iter()
+        .enumerate()
+        .map(|(i, c)| ChartVertex {
+            position: Point2::new(c[0], c[1]),
+            index: i as u32,
+        })
+        .collect();
+    let m = front.len();
+    let use_front = m >= 3 && star_shaped(chart, front);
+    let cdt = ConstrainedDelaunayTriangulation::<ChartVertex>::bulk_load(vertices)
+        .map_err(|e| MeshError::Triangulation(format!("spade rejected a chart point: {e:?}")))?;
+    let mut cdt = cdt;
+    if use_front {
+        // Handles by sample index (duplicates were merged by spade; map through the data).
+        let mut handle = vec![None; chart.len()];
+        for v in cdt.vertices() {
+            handle[v.data().index as usize] = Some(v.fix());
+        }
+        for i in 0..m {
+            let (a, b) = (front[i] as usize, front[(i + 1) % m] as usize);
+            if let (Some(ha), Some(hb)) = (handle[a], handle[b]) {
+                if ha != hb {
+                    cdt.try_add_constraint(ha, hb);
+                }
+            }
+        }
+    }
+    let inside = |c: [f64; 2]| !use_front || inside_star(chart, front, c);
+    let mut triangles = Vec::with_capacity(2 * chart.len());
+    for face in cdt.inner_faces() {
+        let [a, b, c] = face.vertices();
+        let (pa, pb, pc) = (a.position(), b.position(), c.position());
+        let centroid = [(pa.x + pb.x + pc.x) / 3.0, (pa.y + pb.y + pc.y) / 3.0];
+        if inside(centroid) {
+            triangles.push([a.data().index, b.data().index, c.data().index]);
+        }
+    }
+    Ok(triangles)
+}
+
+/// Whether the polygon is star-shaped about the origin with vertices in counter-clockwise
+/// angular order (each wedge less than π): then "inside" is a per-wedge half-plane test.
+fn star_shaped(chart: &[[f64; 2]], front: &[u32]) -> bool {
+    let m = front.len();
+    let mut total = 0.0;
+    for i in 0..m {
+        let a = chart[front[i] as usize];
+        let b = chart[front[(i + 1) % m] as usize];
+        let span = wedge_span(a, b);
+        if span >= std::f64::consts::PI || span <= 0.0 {
+            return false;
+        }
+        total += span;
+    }
+    (total - std::f64::consts::TAU).abs() < 1e-6
+}
+
+fn inside_star(chart: &[[f64; 2]], front: &[u32], c: [f64; 2]) -> bool {
+    // Wedge containing the direction of c, by binary search on the vertex angles.
+    let angle = |p: [f64; 2]| p[1].atan2(p[0]).rem_euclid(std::f64::consts::TAU);
+    let a0 = angle(chart[front[0] as usize]);
+    let rel = |p: [f64; 2]| (angle(p) - a0).rem_euclid(std::f64::consts::TAU);
+    let target = rel(c);
+    let m = front.len();
+    // Vertex angles relative to the first are increasing (star-shaped, counter-clockwise).
+    let (mut lo, mut hi) = (0usize, m);
+    while hi - lo > 1 {
+        let mid = (lo + hi) / 2;
+        if rel(chart[front[mid] as usize]) <= target {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    let a = chart[front[lo] as usize];
+    let b = chart[front[(lo + 1) % m] as usize];
+    cross2(sub2(b, a), sub2(c, a)) >= 0.0
+}
+
+/// Chart 2: triangulates the hole bounded by the front polygon in the plane across the mean
+/// normal of its vertices. Returns no triangles when the projected polygon is not simple.
+fn close_hole(front: &[u32], pos: &[[f64; 3]], normals: &[[f64; 3]]) -> Vec<[u32; 3]> {
+    let m = front.len();
+    let mut mean = [0.0; 3];
+    for n in normals {
+        for k in 0..3 {
+            mean[k] += n[k];
+        }
+    }
+    let len = (mean[0].powi(2) + mean[1].powi(2) + mean[2].powi(2)).sqrt();
+    if !(len > 0.0) {
+        return Vec::new();
+    }
+    let nm = [mean[0] / len, mean[1] / len, mean[2] / len];
+    // Right-handed frame (f1, f2, nm).
+    let helper = if nm[0].abs() < 0.9 { [1.0, 0.0, 0.0] } else { [0.0, 1.0, 0.0] };
+    let f1 = normalize3(cross3(helper, nm));
+    let f2 = cross3(nm, f1);
+    let proj: Vec<[f64; 2]> = front
+        .iter()
+        .map(|&i| {
+            let p = pos[i as usize];
+            [dot3(p, f1), dot3(p, f2)]
+        })
+        .collect();
+    if !simple_polygon(&proj) {
+        return Vec::new();
+    }
+    let vertices: Vec<ChartVertex> = proj
+        .iter()
+        .enumerate()
+        .map(|(i, c)| ChartVertex {
+            position: Point2::new(c[0], c[1]),
+            index: i as u32,
+        })
+        .collect();
+    let edges: Vec<[usize; 2]> = (0..m).map(|i| [i, (i + 1) % m]).collect();
+    let mut conflict = false;
+    let Ok(cdt) = ConstrainedDelaunayTriangulation::<ChartVertex>::try_bulk_load_cdt(
+        vertices,
+        edges,
+        |_| conflict = true,
+    ) else {
+        return Vec::new();
+    };
+    if conflict || cdt.num_vertices() != m {
+        return Vec::new();
+    }
+    let mut out = Vec::new();
+    for face in cdt.inner_faces() {
+        let [a, b, c] = face.vertices();
+        let (pa, pb, pc) = (a.position(), b.position(), c.position());
+        let centroid = [(pa.x + pb.x + pc.x) / 3.0, (pa.y + pb.y + pc.y) / 3.0];
+        if point_in_polygon(&proj, centroid) {
+            out.push([
+                front[a.data().index as usize],
+                front[b.data().index as usize],
+                front[c.data().index as usize],
+            ]);
+        }
+    }
+    out
+}
+
+fn cross3(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ]
+}
+fn dot3(a: [f64; 3], b: [f64; 3]) -> f64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+fn normalize3(a: [f64; 3]) -> [f64; 3] {
+    let l = dot3(a, a).sqrt();
+    [a[0] / l, a[1] / l, a[2] / l]
+}
+
+/// No two non-adjacent edges of the closed polygon meet (O(m²): the hole is small).
+fn simple_polygon(p: &[[f64; 2]]) -> bool {
+    let m = p.len();
+    if m > 4096 {
+        return false;
+    }
+    let seg = |i: usize| (p[i], p[(i + 1) % m]);
+    for i in 0..m {
+        for j in i + 1..m {
+            if j == i + 1 || (i == 0 && j == m - 1) {
+                continue;
+            }
+            let (a, b) = seg(i);
+            let (c, d) = seg(j);
+            let o1 = cross2(sub2(b, a), sub2(c, a));
+            let o2 = cross2(sub2(b, a), sub2(d, a));
+            let o3 = cross2(sub2(d, c), sub2(a, c));
+            let o4 = cross2(sub2(d, c), sub2(b, c));
+            if o1 * o2 <= 0.0 && o3 * o4 <= 0.0 {
+                return false;
+            }
+        }
+    }
+    true
+}
+
+fn point_in_polygon(p: &[[f64; 2]], c: [f64; 2]) -> bool {
+    let m = p.len();
+    let mut inside = false;
+    for i in 0..m {
+        let (a, b) = (p[i], p[(i + 1) % m]);
+        if (a[1] > c[1]) != (b[1] > c[1]) {
+            let x = a[0] + (c[1] - a[1]) * (b[0] - a[0]) / (b[1] - a[1]);
+            if c[0] < x {
+                inside = !inside;
+            }
+        }
+    }
+    inside
+}
+
+/// Builds the mesh from the used samples, renumbering vertices in sample order.
+fn assemble<T: Scalar>(samples: &Samples<T>, pos: &[[f64; 3]], triangles: &[[u32; 3]]) -> Mesh {
+    let n = pos.len();
+    let mut used = vec![false; n];
+    for t in triangles {
+        for &v in t {
+            used[v as usize] = true;
+        }
+    }
+    let mut remap = vec![u32::MAX; n];
+    let mut mesh = Mesh::default();
+    for i in 0..n {
+        if used[i] {
+            remap[i] = mesh.vertices.len() as u32;
+            mesh.vertices.push(pos[i]);
+            mesh.normals.push(samples.normals[i].to_f64());
+            mesh.provenance.push(samples.provenance[i]);
+        }
+    }
+    mesh.triangles = triangles
+        .iter()
+        .map(|t| [remap[t[0] as usize], remap[t[1] as usize], remap[t[2] as usize]])
+        .collect();
+    mesh
+}
