@@ -15,7 +15,7 @@
 //! | fig6 | same | proposed | same | same |
 //!
 //! All presets use `w00 = (1, 0, 0)`, Δt = 0.1, β ∈ [4°, 8°], δ = 1.5, δ' = 0.6, steps clamped
-//! to [0.001, 1], insertion at 1.6 steps, merging at 0.5 steps.
+//! to [0.001, 1], insertion at 2 steps, merging at 0.6 steps.
 
 use crate::model::Invariant;
 use crate::params::{Budget, MeshParams, Method, Mode, Terminal};
@@ -36,7 +36,11 @@ pub const FIG46_INVARIANT: [f64; 18] = [
 ];
 
 /// Initial point of fig4–6.
-pub const FIG46_P0: [f64; 3] = [0.0, 0.0, 1.0];
+pub const FIG46_P0: [f64; 3] = [
+    std::f64::consts::FRAC_1_SQRT_2,
+    0.0,
+    std::f64::consts::FRAC_1_SQRT_2,
+];
 
 /// Largest geodesic radius of fig4–6.
 pub const FIG46_RADIUS: f64 = 1.5;
@@ -111,8 +115,8 @@ impl Preset {
             beta_max: 8f64.to_radians(),
             grow: 1.5,
             shrink: 0.6,
-            gap: 1.6,
-            merge: 0.5,
+            gap: 2.0,
+            merge: 0.6,
             terminal: Terminal {
                 max_radius: if sphere { 10.0 } else { FIG46_RADIUS },
                 bounding_box: 10.0,

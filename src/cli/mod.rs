@@ -1,1 +1,73 @@
-//! The `liemesh` command line (kept in the library so it can be tested).
+//! The `liemesh` command line (in the library so that it can be tested like any other code).
+//!
+//! Exit codes: 0 success, 1 a check failed (e.g. an audit row), 2 bad input or an error
+//! (the message on standard error says what was wrong and what to do).
+
+mod mesh;
+
+use clap::{Parser, Subcommand};
+use std::process::ExitCode;
+use thiserror::Error;
+
+pub use mesh::{mesh_invariant, MeshArgs, MeshOutcome};
+
+/// Adaptive meshes of surfaces defined by Lie-algebra invariants.
+#[derive(Debug, Parser)]
+#[command(name = "liemesh", version, about, long_about = None)]
+pub struct Cli {
+    /// What to do; without a command, meshes the fig6 preset into `out/`.
+    #[command(subcommand)]
+    pub command: Option<Command>,
+}
+
+/// The subcommands.
+#[derive(Debug, Subcommand)]
+pub enum Command {
+    /// Mesh a preset or an invariant file and write the mesh (and a report).
+    Mesh(MeshArgs),
+}
+
+/// Any error the command line reports (exit code 2).
+#[derive(Debug, Error)]
+pub enum CliError {
+    /// Mesh generation failed.
+    #[error(transparent)]
+    Mesh(#[from] crate::MeshError),
+    /// Reading or writing a mesh failed.
+    #[error(transparent)]
+    Io(#[from] crate::io::IoError),
+    /// The invariant file is invalid.
+    #[error(transparent)]
+    InvariantFile(#[from] crate::io::invariant_file::InvariantFileError),
+    /// The arguments contradict each other or name something unavailable.
+    #[error("{0}")]
+    Usage(String),
+    /// Writing a report failed.
+    #[error("cannot write '{path}': {source}")]
+    Write {
+        /// The file.
+        path: std::path::PathBuf,
+        /// The cause.
+        source: std::io::Error,
+    },
+}
+
+/// Parses the process arguments, runs, and turns the result into an exit code.
+pub fn main() -> ExitCode {
+    let cli = Cli::parse();
+    match run(cli) {
+        Ok(code) => code,
+        Err(e) => {
+            eprintln!("liemesh: error: {e}");
+            ExitCode::from(2)
+        }
+    }
+}
+
+/// Runs a parsed command line.
+pub fn run(cli: Cli) -> Result<ExitCode, CliError> {
+    match cli.command {
+        Some(Command::Mesh(args)) => mesh::run(&args),
+        None => mesh::run(&MeshArgs::default_job()),
+    }
+}

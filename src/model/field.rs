@@ -79,7 +79,13 @@ impl<T: Scalar> LieField<T> {
             .parameters::<T>()
             .into_iter()
             .enumerate()
-            .map(|(i, x)| if i == index { Dual::variable(x) } else { Dual::constant(x) })
+            .map(|(i, x)| {
+                if i == index {
+                    Dual::variable(x)
+                } else {
+                    Dual::constant(x)
+                }
+            })
             .collect();
         LieField::from_parameters(&params)
     }
@@ -89,7 +95,9 @@ impl<T: Scalar> LieField<T> {
         let a = Invariant::row_matrix(&params[0..6]);
         let b = Invariant::row_matrix(&params[6..12]);
         let c = Invariant::row_matrix(&params[12..18]);
-        let quadratic = b.iter().any(|r| !(r.x.is_zero() && r.y.is_zero() && r.z.is_zero()));
+        let quadratic = b
+            .iter()
+            .any(|r| !(r.x.is_zero() && r.y.is_zero() && r.z.is_zero()));
         LieField {
             a,
             b,
@@ -121,9 +129,8 @@ fn mat_vec<T: Scalar>(m: &Mat3<T>, p: &Vec3<T>) -> Vec3<T> {
 /// `m p` for a dual point and plain matrix: each entry scales both dual components.
 #[inline(always)]
 fn mat_vec_dual<T: Scalar>(m: &Mat3<T>, p: &Vec3<Dual<T>>) -> Vec3<Dual<T>> {
-    let row = |r: &Vec3<T>| {
-        p.x.clone().scale(&r.x) + p.y.clone().scale(&r.y) + p.z.clone().scale(&r.z)
-    };
+    let row =
+        |r: &Vec3<T>| p.x.clone().scale(&r.x) + p.y.clone().scale(&r.y) + p.z.clone().scale(&r.z);
     Vec3::new(row(&m[0]), row(&m[1]), row(&m[2]))
 }
 
@@ -246,7 +253,11 @@ mod tests {
     fn seeded_field_differentiates_with_respect_to_an_invariant_number() {
         let inv = Invariant::from_numbers(&[2.0, 3.0, 4.0, 0.0, 0.0, 0.0]).unwrap();
         let f = LieField::<f64>::seeded(&inv, 1); // d/dλ2
-        let p = Vec3::new(Dual::constant(1.0), Dual::constant(5.0), Dual::constant(1.0));
+        let p = Vec3::new(
+            Dual::constant(1.0),
+            Dual::constant(5.0),
+            Dual::constant(1.0),
+        );
         let v = f.normal(&p);
         assert_eq!((v.x.eps, v.y.eps, v.z.eps), (0.0, 5.0, 0.0));
     }

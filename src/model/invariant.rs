@@ -172,7 +172,11 @@ impl Invariant {
 
     /// The invariant's numbers in the 18-number layout, converted to `T`.
     pub fn parameters<T: Scalar>(&self) -> Vec<T> {
-        self.rows.iter().flatten().map(|&x| T::from_f64(x)).collect()
+        self.rows
+            .iter()
+            .flatten()
+            .map(|&x| T::from_f64(x))
+            .collect()
     }
 
     /// `A` (paper eq. 2).
@@ -226,7 +230,11 @@ impl Invariant {
     pub fn potential(&self) -> Option<impl Fn([f64; 3]) -> f64> {
         let a = self.a_matrix::<f64>();
         let b = self.b_matrix::<f64>();
-        let scale = a.iter().map(|r| r.to_f64().iter().fold(0.0_f64, |m, x| m.max(x.abs()))).fold(0.0_f64, f64::max).max(1e-300);
+        let scale = a
+            .iter()
+            .map(|r| r.to_f64().iter().fold(0.0_f64, |m, x| m.max(x.abs())))
+            .fold(0.0_f64, f64::max)
+            .max(1e-300);
         let a_sym = (0..3).all(|i| (0..3).all(|j| (a[i][j] - a[j][i]).abs() <= 1e-12 * scale));
         let b_diag = (0..3).all(|i| (0..3).all(|j| i == j || b[i][j].abs() <= 1e-12 * scale));
         if !(a_sym && b_diag) {
@@ -305,7 +313,10 @@ mod tests {
 
     #[test]
     fn wrong_counts_and_non_finite_numbers_are_rejected() {
-        assert_eq!(Invariant::from_numbers(&[1.0; 7]), Err(InvariantError::WrongCount(7)));
+        assert_eq!(
+            Invariant::from_numbers(&[1.0; 7]),
+            Err(InvariantError::WrongCount(7))
+        );
         let mut n = [1.0; 6];
         n[2] = f64::NAN;
         assert!(matches!(

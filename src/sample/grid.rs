@@ -21,7 +21,8 @@ impl Hasher for CellHasher {
     }
     #[inline]
     fn write_i32(&mut self, i: i32) {
-        self.0 = (self.0.rotate_left(5) ^ (i as u32 as u64)).wrapping_mul(0x51_7c_c1_b7_27_22_0a_95);
+        self.0 =
+            (self.0.rotate_left(5) ^ (i as u32 as u64)).wrapping_mul(0x51_7c_c1_b7_27_22_0a_95);
     }
 }
 

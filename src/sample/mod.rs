@@ -17,8 +17,8 @@ use crate::trace::{self, StepConfig, StepLimit};
 use crate::triangulate::Provenance;
 use crate::NormalField;
 use grid::Grid;
-use std::collections::BinaryHeap;
 use std::cmp::Reverse;
+use std::collections::BinaryHeap;
 
 /// How a curve ended.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
@@ -145,7 +145,9 @@ pub fn sample<T: Scalar, F: NormalField<T>>(
             .map(|j| std::f64::consts::TAU * j as f64 / curves as f64)
             .collect(),
         // Step 2: first points p0 + Δt w at least Δt apart ⇔ directions at least 60° apart.
-        Method::Proposed => (0..6).map(|j| std::f64::consts::FRAC_PI_3 * j as f64).collect(),
+        Method::Proposed => (0..6)
+            .map(|j| std::f64::consts::FRAC_PI_3 * j as f64)
+            .collect(),
     };
 
     let mut s = Sampler {
@@ -175,7 +177,9 @@ pub fn sample<T: Scalar, F: NormalField<T>>(
     let n = thetas.len() as u32;
     for (j, &theta) in thetas.iter().enumerate() {
         let j = j as u32;
-        let dir = e1.scale(&T::from_f64(theta.cos())).add_scaled(&T::from_f64(theta.sin()), &e2);
+        let dir = e1
+            .scale(&T::from_f64(theta.cos()))
+            .add_scaled(&T::from_f64(theta.sin()), &e2);
         s.out.curves.push(Curve {
             theta,
             points: vec![0],
@@ -404,7 +408,10 @@ impl<T: Scalar, F: NormalField<T>> Sampler<'_, T, F> {
         len: f64,
     ) {
         use std::f64::consts::TAU;
-        let (tc, tk) = (self.out.curves[c as usize].theta, self.out.curves[k as usize].theta);
+        let (tc, tk) = (
+            self.out.curves[c as usize].theta,
+            self.out.curves[k as usize].theta,
+        );
         // Angular distance going counter-clockwise from c to k (right) or from k to c (left).
         let span = if k_is_right {
             (tk - tc).rem_euclid(TAU)
@@ -414,7 +421,12 @@ impl<T: Scalar, F: NormalField<T>> Sampler<'_, T, F> {
         if span < 1e-9 {
             return;
         }
-        let theta = if k_is_right { tc + span / 2.0 } else { tc - span / 2.0 }.rem_euclid(TAU);
+        let theta = if k_is_right {
+            tc + span / 2.0
+        } else {
+            tc - span / 2.0
+        }
+        .rem_euclid(TAU);
         let d = sub(target, q);
         let half = 0.5 * dot(d, d).sqrt();
         let live_c = &self.live[c as usize];

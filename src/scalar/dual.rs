@@ -102,10 +102,7 @@ impl<T: Scalar> Rem for Dual<T> {
         // x mod y = x − y·trunc(x/y); the derivative of trunc is zero almost everywhere.
         let q = (self.re.clone() / o.re.clone()).to_f64().trunc();
         let q = T::from_f64(q);
-        Dual::new(
-            self.re - q.clone() * o.re,
-            self.eps - q * o.eps,
-        )
+        Dual::new(self.re - q.clone() * o.re, self.eps - q * o.eps)
     }
 }
 impl<T: Scalar> Neg for Dual<T> {

@@ -388,7 +388,13 @@ mod tests {
     fn a_vanishing_normal_stops_the_curve() {
         let params = Preset::Fig3.params();
         let cfg = StepConfig::<f64>::new(&params);
-        let r = step(&sphere(), &cfg, &Vec3::zero(), &Vec3::new(1.0, 0.0, 0.0), &0.1);
+        let r = step(
+            &sphere(),
+            &cfg,
+            &Vec3::zero(),
+            &Vec3::new(1.0, 0.0, 0.0),
+            &0.1,
+        );
         assert_eq!(r.unwrap_err(), StepStop::SingularNormal);
     }
 }

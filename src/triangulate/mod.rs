@@ -242,12 +242,16 @@ fn close_hole(front: &[u32], pos: &[[f64; 3]], normals: &[[f64; 3]]) -> Vec<[u32
         }
     }
     let len = (mean[0].powi(2) + mean[1].powi(2) + mean[2].powi(2)).sqrt();
-    if !(len > 0.0) {
+    if len.is_nan() || len <= 0.0 {
         return Vec::new();
     }
     let nm = [mean[0] / len, mean[1] / len, mean[2] / len];
     // Right-handed frame (f1, f2, nm).
-    let helper = if nm[0].abs() < 0.9 { [1.0, 0.0, 0.0] } else { [0.0, 1.0, 0.0] };
+    let helper = if nm[0].abs() < 0.9 {
+        [1.0, 0.0, 0.0]
+    } else {
+        [0.0, 1.0, 0.0]
+    };
     let f1 = normalize3(cross3(helper, nm));
     let f2 = cross3(nm, f1);
     let proj: Vec<[f64; 2]> = front
@@ -270,11 +274,11 @@ fn close_hole(front: &[u32], pos: &[[f64; 3]], normals: &[[f64; 3]]) -> Vec<[u32
         .collect();
     let edges: Vec<[usize; 2]> = (0..m).map(|i| [i, (i + 1) % m]).collect();
     let mut conflict = false;
-    let Ok(cdt) = ConstrainedDelaunayTriangulation::<ChartVertex>::try_bulk_load_cdt(
-        vertices,
-        edges,
-        |_| conflict = true,
-    ) else {
+    let Ok(cdt) =
+        ConstrainedDelaunayTriangulation::<ChartVertex>::try_bulk_load_cdt(vertices, edges, |_| {
+            conflict = true
+        })
+    else {
         return Vec::new();
     };
     if conflict || cdt.num_vertices() != m {
@@ -373,7 +377,13 @@ fn assemble<T: Scalar>(samples: &Samples<T>, pos: &[[f64; 3]], triangles: &[[u32
     }
     mesh.triangles = triangles
         .iter()
-        .map(|t| [remap[t[0] as usize], remap[t[1] as usize], remap[t[2] as usize]])
+        .map(|t| {
+            [
+                remap[t[0] as usize],
+                remap[t[1] as usize],
+                remap[t[2] as usize],
+            ]
+        })
         .collect();
     mesh
 }

@@ -1,0 +1,349 @@
+//! `liemesh mesh`.
+
+use super::CliError;
+use crate::io::invariant_file::{InvariantFile, ParamsPatch};
+use crate::io::report::Report;
+use crate::io::{self, WriteOptions};
+use crate::model::{Invariant, LieField};
+use crate::preset::Preset;
+use crate::scalar::{Dual, Scalar, ScalarKind};
+use crate::{Mesh, MeshError, MeshParams};
+use clap::Args;
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+use std::time::Instant;
+
+/// Arguments of `liemesh mesh`.
+#[derive(Debug, Clone, Args)]
+pub struct MeshArgs {
+    /// One of the paper's figures.
+    #[arg(long, value_enum, conflicts_with = "invariant")]
+    pub preset: Option<Preset>,
+    /// A TOML invariant file (`invariant = [...]` and an optional `[mesh]` table).
+    #[arg(long, value_name = "FILE")]
+    pub invariant: Option<PathBuf>,
+    /// Output mesh: .ply (binary unless --ascii), .obj or .stl.
+    #[arg(short, long, value_name = "FILE")]
+    pub output: Option<PathBuf>,
+    /// Write PLY as ASCII.
+    #[arg(long)]
+    pub ascii: bool,
+    /// Write a JSON report of the run.
+    #[arg(long, value_name = "FILE.json")]
+    pub report: Option<PathBuf>,
+    /// Scalar type of the computation.
+    #[arg(long, value_enum, default_value = "f64")]
+    pub scalar: ScalarArg,
+    /// Print nothing on success.
+    #[arg(short, long)]
+    pub quiet: bool,
+    /// Parameter overrides (they win over the preset and the file).
+    #[command(flatten)]
+    pub overrides: Overrides,
+}
+
+/// `--scalar` values.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum ScalarArg {
+    /// IEEE single precision.
+    F32,
+    /// IEEE double precision.
+    F64,
+    /// Dual<f64> (the mesh is the real part).
+    Dual,
+    /// Mpfr<256> (needs a build with `--features mpfr`).
+    Mpfr,
+}
+
+impl From<ScalarArg> for ScalarKind {
+    fn from(s: ScalarArg) -> ScalarKind {
+        match s {
+            ScalarArg::F32 => ScalarKind::F32,
+            ScalarArg::F64 => ScalarKind::F64,
+            ScalarArg::Dual => ScalarKind::Dual,
+            ScalarArg::Mpfr => ScalarKind::Mpfr,
+        }
+    }
+}
+
+/// Every mesher parameter as a flag.
+#[derive(Debug, Clone, Default, Args)]
+pub struct Overrides {
+    /// Curve layout: `proposed` or `previous`.
+    #[arg(long, value_parser = ["proposed", "previous"])]
+    pub method: Option<String>,
+    /// Number of curves of the previous method (implies --method previous).
+    #[arg(long)]
+    pub curves: Option<usize>,
+    /// Step rule: `default` (drift-free) or `paper` (explicit Euler, retry loop).
+    #[arg(long, value_parser = ["default", "paper"])]
+    pub mode: Option<String>,
+    /// Initial point `x,y,z`.
+    #[arg(long, value_parser = parse_vec3, allow_hyphen_values = true)]
+    pub p0: Option<[f64; 3]>,
+    /// Initial direction `x,y,z`.
+    #[arg(long, value_parser = parse_vec3, allow_hyphen_values = true)]
+    pub w00: Option<[f64; 3]>,
+    /// Initial step Δt.
+    #[arg(long, allow_hyphen_values = true)]
+    pub dt: Option<f64>,
+    /// Smallest step.
+    #[arg(long, allow_hyphen_values = true)]
+    pub dt_min: Option<f64>,
+    /// Largest step.
+    #[arg(long, allow_hyphen_values = true)]
+    pub dt_max: Option<f64>,
+    /// β_min in degrees.
+    #[arg(long, allow_hyphen_values = true)]
+    pub beta_min: Option<f64>,
+    /// β_max in degrees.
+    #[arg(long, allow_hyphen_values = true)]
+    pub beta_max: Option<f64>,
+    /// Growth factor δ > 1.
+    #[arg(long, allow_hyphen_values = true)]
+    pub grow: Option<f64>,
+    /// Shrink factor δ' in (0, 1).
+    #[arg(long, allow_hyphen_values = true)]
+    pub shrink: Option<f64>,
+    /// Insert a curve when neighbours are this many steps apart.
+    #[arg(long, allow_hyphen_values = true)]
+    pub gap: Option<f64>,
+    /// End a curve closer than this many steps to a neighbour.
+    #[arg(long, allow_hyphen_values = true)]
+    pub merge: Option<f64>,
+    /// Largest geodesic radius.
+    #[arg(long, allow_hyphen_values = true)]
+    pub max_radius: Option<f64>,
+    /// Half-size of the bounding box around the origin.
+    #[arg(long, allow_hyphen_values = true)]
+    pub bounding_box: Option<f64>,
+    /// Do not end curves on collisions nor close the surface.
+    #[arg(long)]
+    pub no_close: bool,
+    /// Point budget.
+    #[arg(long)]
+    pub max_points: Option<usize>,
+    /// Curve budget.
+    #[arg(long)]
+    pub max_curves: Option<usize>,
+    /// Steps-per-curve budget.
+    #[arg(long)]
+    pub max_steps: Option<usize>,
+    /// Retries-per-step budget.
+    #[arg(long)]
+    pub max_retries: Option<usize>,
+}
+
+impl Overrides {
+    fn patch(&self) -> ParamsPatch {
+        ParamsPatch {
+            method: self
+                .method
+                .clone()
+                .or(self.curves.map(|_| "previous".into())),
+            curves: self.curves,
+            mode: self.mode.clone(),
+            p0: self.p0,
+            w00: self.w00,
+            dt: self.dt,
+            dt_min: self.dt_min,
+            dt_max: self.dt_max,
+            beta_min_deg: self.beta_min,
+            beta_max_deg: self.beta_max,
+            grow: self.grow,
+            shrink: self.shrink,
+            gap: self.gap,
+            merge: self.merge,
+            max_radius: self.max_radius,
+            bounding_box: self.bounding_box,
+            close: self.no_close.then_some(false),
+            max_points: self.max_points,
+            max_curves: self.max_curves,
+            max_steps: self.max_steps,
+            max_retries: self.max_retries,
+        }
+    }
+}
+
+fn parse_vec3(s: &str) -> Result<[f64; 3], String> {
+    let parts: Vec<&str> = s.split(',').map(str::trim).collect();
+    if parts.len() != 3 {
+        return Err(format!(
+            "expected three comma-separated numbers like 0,0,1; got \"{s}\""
+        ));
+    }
+    let mut v = [0.0; 3];
+    for (i, p) in parts.iter().enumerate() {
+        v[i] = p
+            .parse::<f64>()
+            .map_err(|_| format!("\"{p}\" is not a number (in \"{s}\")"))?;
+    }
+    Ok(v)
+}
+
+impl MeshArgs {
+    /// The job `liemesh` runs without arguments: the fig6 preset into `out/fig6.ply`.
+    pub fn default_job() -> MeshArgs {
+        MeshArgs {
+            preset: Some(Preset::Fig6),
+            invariant: None,
+            output: Some(PathBuf::from("out/fig6.ply")),
+            ascii: false,
+            report: Some(PathBuf::from("out/fig6.json")),
+            scalar: ScalarArg::F64,
+            quiet: false,
+            overrides: Overrides::default(),
+        }
+    }
+
+    /// The invariant and parameters these arguments describe.
+    pub fn job(&self) -> Result<(Option<Preset>, Invariant, MeshParams), CliError> {
+        let (preset, invariant, mut params) = match (&self.preset, &self.invariant) {
+            (Some(p), None) => (Some(*p), p.invariant(), p.params()),
+            (None, Some(path)) => {
+                let file = InvariantFile::read(path)?;
+                let mut params = MeshParams::default();
+                file.patch.apply(&mut params).map_err(|(k, m)| {
+                    CliError::Usage(format!("{}: mesh.{k}: {m}", path.display()))
+                })?;
+                (None, file.invariant, params)
+            }
+            (None, None) => (
+                Some(Preset::Fig6),
+                Preset::Fig6.invariant(),
+                Preset::Fig6.params(),
+            ),
+            (Some(_), Some(_)) => {
+                return Err(CliError::Usage(
+                    "give either --preset or --invariant, not both".into(),
+                ))
+            }
+        };
+        self.overrides
+            .patch()
+            .apply(&mut params)
+            .map_err(|(k, m)| CliError::Usage(format!("--{k}: {m}")))?;
+        Ok((preset, invariant, params))
+    }
+}
+
+/// The result of meshing an invariant.
+#[derive(Clone, Debug)]
+pub struct MeshOutcome {
+    /// The mesh (f64).
+    pub mesh: Mesh,
+    /// Number of curves traced.
+    pub curves: usize,
+    /// Wall-clock seconds of sampling and triangulation.
+    pub seconds: f64,
+}
+
+fn mesh_in<T: Scalar>(field: &LieField<T>, params: &MeshParams) -> Result<MeshOutcome, MeshError> {
+    let start = Instant::now();
+    let run = crate::run(field, params)?;
+    Ok(MeshOutcome {
+        curves: run.samples.curves.len(),
+        mesh: run.mesh,
+        seconds: start.elapsed().as_secs_f64(),
+    })
+}
+
+/// Meshes `invariant` with `params` in the scalar type `scalar`.
+pub fn mesh_invariant(
+    invariant: &Invariant,
+    params: &MeshParams,
+    scalar: ScalarKind,
+) -> Result<MeshOutcome, CliError> {
+    Ok(match scalar {
+        ScalarKind::F32 => mesh_in(&LieField::<f32>::new(invariant), params)?,
+        ScalarKind::F64 => mesh_in(&LieField::<f64>::new(invariant), params)?,
+        ScalarKind::Dual => mesh_in(&LieField::<Dual<f64>>::new(invariant), params)?,
+        ScalarKind::Mpfr => {
+            #[cfg(feature = "mpfr")]
+            {
+                mesh_in(
+                    &LieField::<crate::scalar::Mpfr<256>>::new(invariant),
+                    params,
+                )?
+            }
+            #[cfg(not(feature = "mpfr"))]
+            {
+                return Err(CliError::Usage(
+                    "--scalar mpfr needs a build with MPFR: rerun with `cargo run --release --features mpfr -- ...`"
+                        .into(),
+                ));
+            }
+        }
+    })
+}
+
+pub(super) fn run(args: &MeshArgs) -> Result<ExitCode, CliError> {
+    let (preset, invariant, params) = args.job()?;
+    if let Some(out) = &args.output {
+        io::MeshFormat::from_path(out)?;
+    }
+    let scalar = ScalarKind::from(args.scalar);
+    let outcome = mesh_invariant(&invariant, &params, scalar)?;
+    if let Some(out) = &args.output {
+        io::write_mesh(
+            &outcome.mesh,
+            out,
+            &WriteOptions {
+                ply_ascii: args.ascii,
+            },
+        )?;
+    }
+    let report = Report::new(
+        preset.map(|p| p.name().to_string()),
+        &invariant,
+        scalar,
+        &outcome.mesh,
+        outcome.curves,
+        outcome.seconds,
+        &params,
+    );
+    if let Some(path) = &args.report {
+        write_json(path, &report)?;
+    }
+    if !args.quiet {
+        print_summary(&report, args.output.as_deref(), args.report.as_deref());
+    }
+    Ok(ExitCode::SUCCESS)
+}
+
+pub(super) fn write_json<S: serde::Serialize>(path: &Path, value: &S) -> Result<(), CliError> {
+    let write = || -> std::io::Result<()> {
+        if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
+            std::fs::create_dir_all(dir)?;
+        }
+        let mut text = serde_json::to_string_pretty(value).map_err(std::io::Error::other)?;
+        text.push('\n');
+        std::fs::write(path, text)
+    };
+    write().map_err(|source| CliError::Write {
+        path: path.to_path_buf(),
+        source,
+    })
+}
+
+fn print_summary(r: &Report, mesh: Option<&Path>, report: Option<&Path>) {
+    let name = r.preset.as_deref().unwrap_or("invariant");
+    println!("liemesh: {name} ({} scalars)", r.scalar);
+    println!("  vertices   {}", r.vertices);
+    println!("  triangles  {}", r.triangles);
+    println!("  curves     {}", r.curves);
+    println!(
+        "  topology   {} (Euler characteristic {}, {} boundary loop{})",
+        if r.closed { "closed" } else { "open" },
+        r.euler_characteristic,
+        r.boundary_loops,
+        if r.boundary_loops == 1 { "" } else { "s" }
+    );
+    println!("  time       {:.2} ms", r.seconds * 1e3);
+    if let Some(m) = mesh {
+        println!("  mesh       {}", m.display());
+    }
+    if let Some(p) = report {
+        println!("  report     {}", p.display());
+    }
+}
