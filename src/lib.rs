@@ -62,7 +62,8 @@ pub fn run<T: Scalar, F: NormalField<T>>(
     params: &MeshParams,
 ) -> Result<MeshRun<T>, MeshError> {
     let samples = sample::sample(field, params)?;
-    let (mesh, chart) = triangulate::triangulate(&samples, params.terminal.close)?;
+    let improve = params.mode == Mode::Default;
+    let (mesh, chart) = triangulate::triangulate(&samples, params.terminal.close, improve)?;
     Ok(MeshRun {
         samples,
         chart,

@@ -395,6 +395,24 @@ impl<T: Scalar, F: NormalField<T>> Sampler<'_, T, F> {
         (dist(q, foot), foot, s_foot)
     }
 
+    /// The foot of `q` on the line of curve `k`'s last segment (or its only point), in the
+    /// working precision.
+    fn foot_on(&self, k: u32, q: &Vec3<T>) -> Vec3<T> {
+        let pts = &self.out.curves[k as usize].points;
+        let x1 = &self.out.points[*pts.last().expect("curves start with one point") as usize];
+        if pts.len() < 2 {
+            return x1.clone();
+        }
+        let x0 = &self.out.points[pts[pts.len() - 2] as usize];
+        let t = x1 - x0;
+        let tt = t.norm_squared();
+        if tt.is_zero() {
+            return x1.clone();
+        }
+        let u = (q - x1).dot(&t) / tt;
+        x1.add_scaled(&u, &t)
+    }
+
     /// Step 6: a new curve between `c` (which just stepped to `q`) and its neighbour `k`.
     #[allow(clippy::too_many_arguments)]
     fn insert_between(
@@ -418,7 +436,7 @@ impl<T: Scalar, F: NormalField<T>> Sampler<'_, T, F> {
         } else {
             (tc - tk).rem_euclid(TAU)
         };
-        if span < 1e-9 {
+        if span < 1e-9 || self.out.points.len() >= self.params.budget.max_points {
             return;
         }
         let theta = if k_is_right {
@@ -427,16 +445,13 @@ impl<T: Scalar, F: NormalField<T>> Sampler<'_, T, F> {
             tc - span / 2.0
         }
         .rem_euclid(TAU);
-        let d = sub(target, q);
-        let half = 0.5 * dot(d, d).sqrt();
+        // In the working precision, so that dual numbers carry derivatives through insertion.
+        let _ = (q, target);
         let live_c = &self.live[c as usize];
-        let start = match trace::step_fixed(
-            self.field,
-            &self.cfg,
-            &live_c.p,
-            &Vec3::from_f64(d),
-            &T::from_f64(half),
-        ) {
+        let foot = self.foot_on(k, &live_c.p);
+        let d = &foot - &live_c.p;
+        let half = d.norm() * T::from_f64(0.5);
+        let start = match trace::step_fixed(self.field, &self.cfg, &live_c.p, &d, &half) {
             Ok(p) => p,
             Err(_) => return,
         };

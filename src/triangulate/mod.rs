@@ -9,7 +9,9 @@
 //!    the two charts are stitched edge to edge and the mesh is watertight.
 //! 3. Triangles are counter-clockwise in both charts, whose frames are right-handed about the
 //!    field normal: every triangle is oriented with the field normal.
+//! 4. In the default mode, edge flips make the result Delaunay on the surface itself.
 
+mod flip;
 mod mesh;
 
 pub use mesh::{Mesh, Provenance};
@@ -47,10 +49,15 @@ impl HasPosition for ChartVertex {
 }
 
 /// Triangulates `samples` into a mesh (and returns the chart triangulation beside it).
+///
+/// With `improve`, edges are then flipped until the mesh is Delaunay on the surface (see the
+/// module docs); without it the mesh is exactly the charts' triangulations (the paper).
 pub fn triangulate<T: Scalar>(
     samples: &Samples<T>,
     close: bool,
+    improve: bool,
 ) -> Result<(Mesh, ChartTriangulation), MeshError> {
+    check_samples(samples)?;
     let n = samples.points.len();
     if n < 3 {
         return Err(MeshError::Triangulation(format!(
@@ -73,6 +80,11 @@ pub fn triangulate<T: Scalar>(
 
     let mut all = triangles.clone();
     all.extend_from_slice(&closing);
+    if improve {
+        let normals: Vec<[f64; 3]> = samples.normals.iter().map(|v| v.to_f64()).collect();
+        let budget = 8 * all.len() + 64;
+        flip::flip_to_surface_delaunay(&pos, &normals, &mut all, budget);
+    }
     let mesh = assemble(samples, &pos, &all);
     Ok((
         mesh,
@@ -83,6 +95,40 @@ pub fn triangulate<T: Scalar>(
             closing,
         },
     ))
+}
+
+/// Rejects samples that [`sample`](crate::sample::sample) cannot produce but a caller who
+/// builds [`Samples`] by hand can: vectors of different lengths, curves without points or
+/// naming points that do not exist, and non-finite points or normals (which would end up as
+/// NaN vertices).
+fn check_samples<T: Scalar>(samples: &Samples<T>) -> Result<(), MeshError> {
+    let n = samples.points.len();
+    let bad = |what: String| Err(MeshError::Triangulation(what));
+    if samples.normals.len() != n || samples.provenance.len() != n {
+        return bad(format!(
+            "inconsistent samples: {n} points, {} normals and {} provenance entries (all must be equal)",
+            samples.normals.len(),
+            samples.provenance.len()
+        ));
+    }
+    for (c, curve) in samples.curves.iter().enumerate() {
+        if curve.points.is_empty() {
+            return bad(format!("inconsistent samples: curve {c} has no points"));
+        }
+        if let Some(&i) = curve.points.iter().find(|&&i| i as usize >= n) {
+            return bad(format!(
+                "inconsistent samples: curve {c} names point {i}, but there are {n} points"
+            ));
+        }
+    }
+    if let Some(i) = (0..n).find(|&i| !(samples.points[i].is_finite() && samples.normals[i].is_finite())) {
+        return bad(format!(
+            "sample point {i} or its normal is not finite: {:?}, {:?}",
+            samples.points[i].to_f64(),
+            samples.normals[i].to_f64()
+        ));
+    }
+    Ok(())
 }
 
 /// The front polygon: each curve's last point in order of θ, without the ends of merged

@@ -1,0 +1,109 @@
+//! The command line as a user runs it.
+
+use std::path::PathBuf;
+use std::process::Command;
+
+fn liemesh() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_liemesh"))
+}
+
+fn scratch(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("liemesh-cli-{}-{name}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+#[test]
+fn every_preset_meshes_with_a_report() {
+    let dir = scratch("presets");
+    let mut triangles = Vec::new();
+    for i in 1..=6 {
+        let out = dir.join(format!("fig{i}.ply"));
+        let report = dir.join(format!("fig{i}.json"));
+        let status = liemesh()
+            .args(["mesh", "--preset", &format!("fig{i}"), "-q", "-o"])
+            .arg(&out)
+            .arg("--report")
+            .arg(&report)
+            .status()
+            .unwrap();
+        assert!(status.success());
+        let r: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(&report).unwrap()).unwrap();
+        for key in [
+            "vertices",
+            "triangles",
+            "curves",
+            "closed",
+            "euler_characteristic",
+            "boundary_loops",
+            "seconds",
+            "parameters",
+        ] {
+            assert!(r.get(key).is_some(), "report lacks {key}");
+        }
+        triangles.push(r["triangles"].as_u64().unwrap());
+        assert!(std::fs::metadata(&out).unwrap().len() > 0);
+    }
+    assert!(triangles[0] < triangles[2] && triangles[2] < triangles[1], "{triangles:?}");
+    assert!(triangles[3] < triangles[5] && triangles[5] < triangles[4], "{triangles:?}");
+}
+
+#[test]
+fn no_arguments_meshes_fig6_into_out() {
+    let dir = scratch("default");
+    let o = liemesh().current_dir(&dir).output().unwrap();
+    assert!(o.status.success());
+    let text = String::from_utf8(o.stdout).unwrap();
+    for word in ["vertices", "triangles", "curves", "time"] {
+        assert!(text.contains(word), "summary lacks {word}: {text}");
+    }
+    assert!(dir.join("out/fig6.ply").exists());
+}
+
+#[test]
+fn bad_input_exits_2_with_a_one_line_message() {
+    let dir = scratch("bad");
+    let o = liemesh()
+        .args(["mesh", "--preset", "fig3", "--dt", "-1", "-o"])
+        .arg(dir.join("x.ply"))
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(2));
+    let err = String::from_utf8(o.stderr).unwrap();
+    assert!(err.contains("dt") && err.trim().lines().count() == 1, "{err}");
+
+    let o = liemesh()
+        .args(["mesh", "--preset", "fig3", "-o"])
+        .arg(dir.join("x.xyz"))
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(2));
+
+    let file = dir.join("bad.toml");
+    std::fs::write(&file, "invariant = [1, 1, 1, 0, 0, 0]\n[mesh]\nmethod = \"fast\"\n").unwrap();
+    let o = liemesh().args(["mesh", "--invariant"]).arg(&file).output().unwrap();
+    assert_eq!(o.status.code(), Some(2));
+    let err = String::from_utf8(o.stderr).unwrap();
+    assert!(err.contains("mesh.method") && err.contains("\"previous\""), "{err}");
+    assert_eq!(err.trim().lines().count(), 1, "{err}");
+}
+
+#[test]
+fn an_invariant_file_meshes_an_ellipsoid_in_every_format() {
+    let dir = scratch("ellipsoid");
+    let file = dir.join("ellipsoid.toml");
+    std::fs::write(&file, "invariant = [1, 4, 16, 0, 0, 0]\n[mesh]\np0 = [0.0, 0.0, 0.25]\ndt = 0.05\n").unwrap();
+    for ext in ["ply", "obj", "stl"] {
+        let out = dir.join(format!("e.{ext}"));
+        let status = liemesh()
+            .args(["mesh", "-q", "--invariant"])
+            .arg(&file)
+            .arg("-o")
+            .arg(&out)
+            .status()
+            .unwrap();
+        assert!(status.success(), "{ext}");
+        assert!(std::fs::metadata(&out).unwrap().len() > 100);
+    }
+}

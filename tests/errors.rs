@@ -1,0 +1,114 @@
+//! Every bad input gets its typed error, never a panic.
+
+use liemesh::model::{Invariant, InvariantError, LieField};
+use liemesh::preset::Preset;
+use liemesh::{generate, MeshError, MeshParams, Method};
+
+fn mesh_sphere(params: &MeshParams) -> Result<liemesh::Mesh, MeshError> {
+    generate(&LieField::<f64>::new(&Preset::Fig3.invariant()), params)
+}
+
+fn with(f: impl FnOnce(&mut MeshParams)) -> Result<liemesh::Mesh, MeshError> {
+    let mut p = Preset::Fig3.params();
+    f(&mut p);
+    mesh_sphere(&p)
+}
+
+#[test]
+fn non_finite_numbers_are_rejected() {
+    assert!(matches!(with(|p| p.dt = f64::NAN), Err(MeshError::NonFinite { name: "dt", .. })));
+    assert!(matches!(
+        with(|p| p.p0[1] = f64::INFINITY),
+        Err(MeshError::NonFinite { name: "p0.y", .. })
+    ));
+    assert!(matches!(
+        with(|p| p.beta_max = f64::NEG_INFINITY),
+        Err(MeshError::NonFinite { .. })
+    ));
+    assert!(matches!(
+        Invariant::from_numbers(&[1.0, f64::NAN, 1.0, 0.0, 0.0, 0.0]),
+        Err(InvariantError::NonFinite { index: 2, .. })
+    ));
+}
+
+#[test]
+fn a_direction_parallel_to_the_normal_is_rejected() {
+    let e = with(|p| p.w00 = [0.0, 0.0, 2.0]).unwrap_err();
+    assert!(matches!(e, MeshError::DirectionParallelToNormal { .. }), "{e}");
+    assert!(e.to_string().contains("tangent plane"));
+}
+
+#[test]
+fn a_vanishing_normal_at_p0_is_rejected() {
+    let e = with(|p| p.p0 = [0.0, 0.0, 0.0]).unwrap_err();
+    assert!(matches!(e, MeshError::SingularInitialPoint { .. }), "{e}");
+}
+
+#[test]
+fn an_inverted_or_empty_angle_band_is_rejected() {
+    let e = with(|p| {
+        p.beta_min = 8f64.to_radians();
+        p.beta_max = 4f64.to_radians();
+    })
+    .unwrap_err();
+    assert!(matches!(e, MeshError::AngleBand { .. }), "{e}");
+    let e = with(|p| p.beta_min = p.beta_max).unwrap_err();
+    assert!(matches!(e, MeshError::AngleBand { .. }));
+}
+
+#[test]
+fn a_non_positive_step_is_rejected() {
+    for dt in [0.0, -0.1] {
+        let e = with(|p| p.dt = dt).unwrap_err();
+        assert!(matches!(e, MeshError::StepSize { name: "dt", .. }), "{e}");
+    }
+}
+
+#[test]
+fn growth_and_shrink_factors_must_grow_and_shrink() {
+    assert_eq!(with(|p| p.grow = 1.0).unwrap_err(), MeshError::GrowthFactor(1.0));
+    assert_eq!(with(|p| p.shrink = 1.0).unwrap_err(), MeshError::ShrinkFactor(1.0));
+    assert_eq!(with(|p| p.shrink = 0.0).unwrap_err(), MeshError::ShrinkFactor(0.0));
+}
+
+#[test]
+fn zero_budgets_are_rejected() {
+    assert_eq!(
+        with(|p| p.budget.max_points = 0).unwrap_err(),
+        MeshError::ZeroBudget("max_points")
+    );
+    assert_eq!(
+        with(|p| p.budget.max_curves = 0).unwrap_err(),
+        MeshError::ZeroBudget("max_curves")
+    );
+    assert_eq!(
+        with(|p| p.budget.max_steps_per_curve = 0).unwrap_err(),
+        MeshError::ZeroBudget("max_steps_per_curve")
+    );
+    assert_eq!(
+        with(|p| p.budget.max_retries = 0).unwrap_err(),
+        MeshError::ZeroBudget("max_retries")
+    );
+}
+
+#[test]
+fn too_few_previous_method_curves_are_rejected() {
+    let e = with(|p| p.method = Method::Previous { curves: 2 }).unwrap_err();
+    assert_eq!(e, MeshError::TooFewCurves(2));
+}
+
+#[test]
+fn an_unsupported_output_extension_is_rejected() {
+    let e = liemesh::io::MeshFormat::from_path(std::path::Path::new("mesh.xyz")).unwrap_err();
+    let msg = e.to_string();
+    assert!(msg.contains(".ply") && msg.contains(".obj") && msg.contains(".stl"), "{msg}");
+}
+
+#[test]
+fn small_budgets_end_the_run_without_error() {
+    let m = with(|p| p.budget.max_points = 50).unwrap();
+    assert!(m.vertices.len() <= 50);
+    for v in &m.vertices {
+        assert!(v.iter().all(|x| x.is_finite()));
+    }
+}
