@@ -34,6 +34,12 @@ pub struct MeshArgs {
     /// Scalar type of the computation.
     #[arg(long, value_enum, default_value = "f64")]
     pub scalar: ScalarArg,
+    /// Also draw the mesh into this picture (.png or .svg).
+    #[arg(long, value_name = "FILE")]
+    pub png: Option<PathBuf>,
+    /// Picture options for --png.
+    #[command(flatten)]
+    pub picture: super::render::PictureArgs,
     /// Print nothing on success.
     #[arg(short, long)]
     pub quiet: bool,
@@ -165,7 +171,7 @@ impl Overrides {
     }
 }
 
-fn parse_vec3(s: &str) -> Result<[f64; 3], String> {
+pub(super) fn parse_vec3(s: &str) -> Result<[f64; 3], String> {
     let parts: Vec<&str> = s.split(',').map(str::trim).collect();
     if parts.len() != 3 {
         return Err(format!(
@@ -191,6 +197,13 @@ impl MeshArgs {
             ascii: false,
             report: Some(PathBuf::from("out/fig6.json")),
             scalar: ScalarArg::F64,
+            png: None,
+            picture: super::render::PictureArgs {
+                view: [2.0, -3.0, 1.6],
+                perspective: None,
+                color_by: "none".into(),
+                size: 800,
+            },
             quiet: false,
             overrides: Overrides::default(),
         }
@@ -292,6 +305,9 @@ pub(super) fn run(args: &MeshArgs) -> Result<ExitCode, CliError> {
                 ply_ascii: args.ascii,
             },
         )?;
+    }
+    if let Some(png) = &args.png {
+        crate::io::render::render_to_file(&outcome.mesh, png, &args.picture.options())?;
     }
     let report = Report::new(
         preset.map(|p| p.name().to_string()),

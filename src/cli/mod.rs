@@ -4,6 +4,7 @@
 //! (the message on standard error says what was wrong and what to do).
 
 mod mesh;
+mod render;
 
 use clap::{Parser, Subcommand};
 use std::process::ExitCode;
@@ -25,6 +26,8 @@ pub struct Cli {
 pub enum Command {
     /// Mesh a preset or an invariant file and write the mesh (and a report).
     Mesh(MeshArgs),
+    /// Draw a mesh file as a wireframe picture (.png or .svg).
+    Render(render::RenderArgs),
 }
 
 /// Any error the command line reports (exit code 2).
@@ -42,6 +45,9 @@ pub enum CliError {
     /// The arguments contradict each other or name something unavailable.
     #[error("{0}")]
     Usage(String),
+    /// Drawing a picture failed.
+    #[error(transparent)]
+    Render(#[from] crate::io::render::RenderError),
     /// Writing a report failed.
     #[error("cannot write '{path}': {source}")]
     Write {
@@ -68,6 +74,7 @@ pub fn main() -> ExitCode {
 pub fn run(cli: Cli) -> Result<ExitCode, CliError> {
     match cli.command {
         Some(Command::Mesh(args)) => mesh::run(&args),
+        Some(Command::Render(args)) => render::run(&args),
         None => mesh::run(&MeshArgs::default_job()),
     }
 }

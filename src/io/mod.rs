@@ -37,7 +37,7 @@ use crate::triangulate::Mesh;
 pub mod invariant_file;
 pub mod obj;
 pub mod ply;
-// pub mod render;
+pub mod render;
 pub mod report;
 pub mod stl;
 // ---------------------------------------------------------------------------
