@@ -42,6 +42,11 @@ pub use model::NormalField;
 pub use params::{Budget, MeshParams, Method, Mode, Terminal};
 pub use triangulate::{Mesh, Provenance};
 
+/// The README's examples, compiled and run as doctests.
+#[cfg(doctest)]
+#[doc = include_str!("../README.md")]
+pub struct ReadmeDoctests;
+
 use scalar::Scalar;
 
 /// Everything one meshing run produced.

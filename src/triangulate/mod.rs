@@ -121,7 +121,9 @@ fn check_samples<T: Scalar>(samples: &Samples<T>) -> Result<(), MeshError> {
             ));
         }
     }
-    if let Some(i) = (0..n).find(|&i| !(samples.points[i].is_finite() && samples.normals[i].is_finite())) {
+    if let Some(i) =
+        (0..n).find(|&i| !(samples.points[i].is_finite() && samples.normals[i].is_finite()))
+    {
         return bad(format!(
             "sample point {i} or its normal is not finite: {:?}, {:?}",
             samples.points[i].to_f64(),
@@ -308,7 +310,7 @@ fn close_hole(front: &[u32], pos: &[[f64; 3]], normals: &[[f64; 3]]) -> Vec<[u32
         })
         .collect();
     if !simple_polygon(&proj) {
-        return Vec::new();
+        return clip_ears(front, pos, normals);
     }
     let vertices: Vec<ChartVertex> = proj
         .iter()
@@ -328,7 +330,7 @@ fn close_hole(front: &[u32], pos: &[[f64; 3]], normals: &[[f64; 3]]) -> Vec<[u32
         return Vec::new();
     };
     if conflict || cdt.num_vertices() != m {
-        return Vec::new();
+        return clip_ears(front, pos, normals);
     }
     let mut out = Vec::new();
     for face in cdt.inner_faces() {
@@ -344,6 +346,53 @@ fn close_hole(front: &[u32], pos: &[[f64; 3]], normals: &[[f64; 3]]) -> Vec<[u32
         }
     }
     out
+}
+
+/// Closes a hole whose projection is not a simple polygon (e.g. the thin band an ellipsoid's
+/// curves leave along a caustic): repeatedly cuts off the ear with the smallest angle inside
+/// the hole, measured in space about the field normal, never creating an edge twice.
+fn clip_ears(front: &[u32], pos: &[[f64; 3]], normals: &[[f64; 3]]) -> Vec<[u32; 3]> {
+    // (sample index, normal) around the loop; the hole lies to the right of the loop.
+    let mut ring: Vec<(u32, [f64; 3])> =
+        front.iter().copied().zip(normals.iter().copied()).collect();
+    let mut edges: std::collections::HashSet<(u32, u32)> = (0..ring.len())
+        .map(|i| {
+            let (a, b) = (ring[i].0, ring[(i + 1) % ring.len()].0);
+            (a.min(b), a.max(b))
+        })
+        .collect();
+    let mut out = Vec::with_capacity(ring.len());
+    while ring.len() > 3 {
+        let m = ring.len();
+        let mut best: Option<(f64, usize)> = None;
+        for i in 0..m {
+            let (a, b, c) = (ring[(i + m - 1) % m].0, ring[i].0, ring[(i + 1) % m].0);
+            if edges.contains(&(a.min(c), a.max(c))) {
+                continue;
+            }
+            let u = sub3(pos[a as usize], pos[b as usize]);
+            let w = sub3(pos[c as usize], pos[b as usize]);
+            let angle = dot3(ring[i].1, cross3(u, w))
+                .atan2(dot3(u, w))
+                .rem_euclid(std::f64::consts::TAU);
+            if best.is_none_or(|(b, _)| angle < b) {
+                best = Some((angle, i));
+            }
+        }
+        let Some((_, i)) = best else {
+            return Vec::new();
+        };
+        let (a, b, c) = (ring[(i + m - 1) % m].0, ring[i].0, ring[(i + 1) % m].0);
+        out.push([c, b, a]);
+        edges.insert((a.min(c), a.max(c)));
+        ring.remove(i);
+    }
+    out.push([ring[2].0, ring[1].0, ring[0].0]);
+    out
+}
+
+fn sub3(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
 }
 
 fn cross3(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
