@@ -25,6 +25,7 @@
 //! ```
 #![warn(missing_docs)]
 
+pub mod audit;
 pub mod cli;
 mod error;
 pub mod io;
@@ -58,6 +59,8 @@ pub struct MeshRun<T> {
     pub chart: triangulate::ChartTriangulation,
     /// The mesh.
     pub mesh: Mesh,
+    /// The mesh's vertices in the working precision (`mesh.vertices` rounded to `f64`).
+    pub vertices: Vec<scalar::Vec3<T>>,
 }
 
 /// Samples and triangulates the surface of `field` (the whole pipeline), keeping the
@@ -68,11 +71,23 @@ pub fn run<T: Scalar, F: NormalField<T>>(
 ) -> Result<MeshRun<T>, MeshError> {
     let samples = sample::sample(field, params)?;
     let improve = params.mode == Mode::Default;
-    let (mesh, chart) = triangulate::triangulate(&samples, params.terminal.close, improve)?;
+    let (mut mesh, chart) = triangulate::triangulate(&samples, params.terminal.close, improve)?;
+    let vertices = if improve {
+        triangulate::relax(field, params, &samples, &mut mesh)
+    } else {
+        mesh.provenance
+            .iter()
+            .map(|pr| {
+                samples.points[samples.curves[pr.curve as usize].points[pr.step as usize] as usize]
+                    .clone()
+            })
+            .collect()
+    };
     Ok(MeshRun {
         samples,
         chart,
         mesh,
+        vertices,
     })
 }
 

@@ -15,7 +15,7 @@
 //! | fig6 | same | proposed | same | same |
 //!
 //! All presets use `w00 = (1, 0, 0)`, Δt = 0.1, β ∈ [4°, 8°], δ = 1.5, δ' = 0.6, steps clamped
-//! to [0.001, 1], insertion at 2 steps, merging at 0.6 steps.
+//! to [0.001, 1], insertion at 1.8 steps, merging at 0.7 steps.
 
 use crate::model::Invariant;
 use crate::params::{Budget, MeshParams, Method, Mode, Terminal};
@@ -116,8 +116,8 @@ impl Preset {
             beta_max: 8f64.to_radians(),
             grow: 1.5,
             shrink: 0.6,
-            gap: 2.0,
-            merge: 0.6,
+            gap: 1.8,
+            merge: 0.7,
             terminal: Terminal {
                 max_radius: if sphere { 10.0 } else { FIG46_RADIUS },
                 bounding_box: 10.0,

@@ -45,8 +45,14 @@ fn every_preset_meshes_with_a_report() {
         triangles.push(r["triangles"].as_u64().unwrap());
         assert!(std::fs::metadata(&out).unwrap().len() > 0);
     }
-    assert!(triangles[0] < triangles[2] && triangles[2] < triangles[1], "{triangles:?}");
-    assert!(triangles[3] < triangles[5] && triangles[5] < triangles[4], "{triangles:?}");
+    assert!(
+        triangles[0] < triangles[2] && triangles[2] < triangles[1],
+        "{triangles:?}"
+    );
+    assert!(
+        triangles[3] < triangles[5] && triangles[5] < triangles[4],
+        "{triangles:?}"
+    );
 }
 
 #[test]
@@ -71,7 +77,10 @@ fn bad_input_exits_2_with_a_one_line_message() {
         .unwrap();
     assert_eq!(o.status.code(), Some(2));
     let err = String::from_utf8(o.stderr).unwrap();
-    assert!(err.contains("dt") && err.trim().lines().count() == 1, "{err}");
+    assert!(
+        err.contains("dt") && err.trim().lines().count() == 1,
+        "{err}"
+    );
 
     let o = liemesh()
         .args(["mesh", "--preset", "fig3", "-o"])
@@ -81,11 +90,22 @@ fn bad_input_exits_2_with_a_one_line_message() {
     assert_eq!(o.status.code(), Some(2));
 
     let file = dir.join("bad.toml");
-    std::fs::write(&file, "invariant = [1, 1, 1, 0, 0, 0]\n[mesh]\nmethod = \"fast\"\n").unwrap();
-    let o = liemesh().args(["mesh", "--invariant"]).arg(&file).output().unwrap();
+    std::fs::write(
+        &file,
+        "invariant = [1, 1, 1, 0, 0, 0]\n[mesh]\nmethod = \"fast\"\n",
+    )
+    .unwrap();
+    let o = liemesh()
+        .args(["mesh", "--invariant"])
+        .arg(&file)
+        .output()
+        .unwrap();
     assert_eq!(o.status.code(), Some(2));
     let err = String::from_utf8(o.stderr).unwrap();
-    assert!(err.contains("mesh.method") && err.contains("\"previous\""), "{err}");
+    assert!(
+        err.contains("mesh.method") && err.contains("\"previous\""),
+        "{err}"
+    );
     assert_eq!(err.trim().lines().count(), 1, "{err}");
 }
 
@@ -93,7 +113,11 @@ fn bad_input_exits_2_with_a_one_line_message() {
 fn an_invariant_file_meshes_an_ellipsoid_in_every_format() {
     let dir = scratch("ellipsoid");
     let file = dir.join("ellipsoid.toml");
-    std::fs::write(&file, "invariant = [1, 4, 16, 0, 0, 0]\n[mesh]\np0 = [0.0, 0.0, 0.25]\ndt = 0.05\n").unwrap();
+    std::fs::write(
+        &file,
+        "invariant = [1, 4, 16, 0, 0, 0]\n[mesh]\np0 = [0.0, 0.0, 0.25]\ndt = 0.05\n",
+    )
+    .unwrap();
     for ext in ["ply", "obj", "stl"] {
         let out = dir.join(format!("e.{ext}"));
         let status = liemesh()

@@ -30,7 +30,10 @@ fn fig3_is_a_closed_oriented_sphere() {
     assert_eq!(topo.orientation_flips, 0);
     for v in &r.mesh.vertices {
         let radius = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
-        assert!((radius - 1.0).abs() < 1e-3, "vertex off the sphere: {radius}");
+        assert!(
+            (radius - 1.0).abs() < 1e-3,
+            "vertex off the sphere: {radius}"
+        );
     }
 }
 
@@ -41,7 +44,10 @@ fn every_sphere_preset_closes_in_both_modes() {
             let params = liemesh::MeshParams { mode, ..p.params() };
             let r = run(&LieField::<f64>::new(&p.invariant()), &params).unwrap();
             let topo = Topology::of(&r.mesh);
-            assert!(topo.closed && topo.euler_characteristic == 2, "{p} {mode:?}: {topo:?}");
+            assert!(
+                topo.closed && topo.euler_characteristic == 2,
+                "{p} {mode:?}: {topo:?}"
+            );
         }
     }
 }
@@ -55,7 +61,11 @@ fn triangles_face_the_way_the_field_normal_points() {
             let [a, b, c] = t.map(|i| m.vertices[i as usize]);
             let u = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
             let w = [c[0] - a[0], c[1] - a[1], c[2] - a[2]];
-            let n = [u[1] * w[2] - u[2] * w[1], u[2] * w[0] - u[0] * w[2], u[0] * w[1] - u[1] * w[0]];
+            let n = [
+                u[1] * w[2] - u[2] * w[1],
+                u[2] * w[0] - u[0] * w[2],
+                u[0] * w[1] - u[1] * w[0],
+            ];
             let fn_: [f64; 3] = (0..3)
                 .map(|k| t.iter().map(|&i| m.normals[i as usize][k]).sum::<f64>())
                 .collect::<Vec<_>>()
@@ -65,7 +75,10 @@ fn triangles_face_the_way_the_field_normal_points() {
                 against += 1;
             }
         }
-        assert_eq!(against, 0, "{p}: {against} triangles face against the field normal");
+        assert_eq!(
+            against, 0,
+            "{p}: {against} triangles face against the field normal"
+        );
     }
 }
 
@@ -73,8 +86,16 @@ fn triangles_face_the_way_the_field_normal_points() {
 fn open_presets_are_discs() {
     for p in [Preset::Fig4, Preset::Fig5, Preset::Fig6] {
         let topo = Topology::of(&preset_run::<f64>(p).mesh);
-        assert_eq!((topo.euler_characteristic, topo.boundary_loops), (1, 1), "{p}: {topo:?}");
-        assert_eq!((topo.non_manifold_edges, topo.orientation_flips), (0, 0), "{p}");
+        assert_eq!(
+            (topo.euler_characteristic, topo.boundary_loops),
+            (1, 1),
+            "{p}: {topo:?}"
+        );
+        assert_eq!(
+            (topo.non_manifold_edges, topo.orientation_flips),
+            (0, 0),
+            "{p}"
+        );
     }
 }
 
@@ -98,7 +119,11 @@ fn fig3_runs_in_f32_f64_and_dual() {
     assert!(topo.closed && topo.euler_characteristic == 2, "{topo:?}");
     for v in &m32.vertices {
         let r = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
-        assert!((r - 1.0).abs() < 1e-5, "f32 vertex off the sphere by {}", r - 1.0);
+        assert!(
+            (r - 1.0).abs() < 1e-5,
+            "f32 vertex off the sphere by {}",
+            r - 1.0
+        );
     }
 }
 
@@ -139,7 +164,9 @@ fn dual_numbers_carry_vertex_sensitivities() {
         if !mine.contains_key(&key(pr)) {
             continue;
         }
-        let Some(&j) = index.get(&key(pr)) else { continue };
+        let Some(&j) = index.get(&key(pr)) else {
+            continue;
+        };
         let p = &rp.samples.points[j];
         compared += 1;
         for k in 0..3 {
@@ -148,7 +175,10 @@ fn dual_numbers_carry_vertex_sensitivities() {
         }
     }
     assert!(compared > 100, "only {compared} points in common");
-    assert!(worst < 1e-4, "dual sensitivity vs finite difference: {worst}");
+    assert!(
+        worst < 1e-4,
+        "dual sensitivity vs finite difference: {worst}"
+    );
 }
 
 #[cfg(feature = "mpfr")]
@@ -157,13 +187,36 @@ fn fig3_in_f64_agrees_with_mpfr256_within_1e_minus_9() {
     use liemesh::scalar::Mpfr;
     let r64 = preset_run::<f64>(Preset::Fig3);
     let rmp = preset_run::<Mpfr<256>>(Preset::Fig3);
-    assert_eq!(r64.mesh.triangles, rmp.mesh.triangles);
-    let err = r64
-        .samples
-        .points
-        .iter()
-        .zip(&rmp.samples.points)
-        .flat_map(|(a, b)| (0..3).map(move |k| (a[k] - b[k].to_f64()).abs()))
-        .fold(0.0_f64, f64::max);
-    assert!(err <= 1e-9, "f64 vs Mpfr<256>: {err:e}");
+    // Same discrete decisions: the same curves and points (arc lengths differ in the last
+    // bits), and the same triangles up to where each triangle's listing starts.
+    let ids = |r: &[liemesh::Provenance]| r.iter().map(|p| (p.curve, p.step)).collect::<Vec<_>>();
+    assert_eq!(ids(&r64.samples.provenance), ids(&rmp.samples.provenance));
+    let canonical = |t: &[[u32; 3]]| {
+        let mut v: Vec<[u32; 3]> = t
+            .iter()
+            .map(|t| {
+                let k = (0..3).min_by_key(|&k| t[k]).unwrap();
+                [t[k], t[(k + 1) % 3], t[(k + 2) % 3]]
+            })
+            .collect();
+        v.sort_unstable();
+        v
+    };
+    assert_eq!(
+        canonical(&r64.mesh.triangles),
+        canonical(&rmp.mesh.triangles)
+    );
+    let max_diff = |a: &[liemesh::scalar::Vec3<f64>], b: &[liemesh::scalar::Vec3<Mpfr<256>>]| {
+        a.iter()
+            .zip(b)
+            .flat_map(|(a, b)| (0..3).map(move |k| (a[k] - b[k].to_f64()).abs()))
+            .fold(0.0_f64, f64::max)
+    };
+    let samples = max_diff(&r64.samples.points, &rmp.samples.points);
+    let vertices = max_diff(&r64.vertices, &rmp.vertices);
+    assert!(samples <= 1e-9, "samples, f64 vs Mpfr<256>: {samples:e}");
+    assert!(
+        vertices <= 1e-9,
+        "mesh vertices, f64 vs Mpfr<256>: {vertices:e}"
+    );
 }

@@ -16,7 +16,10 @@ fn with(f: impl FnOnce(&mut MeshParams)) -> Result<liemesh::Mesh, MeshError> {
 
 #[test]
 fn non_finite_numbers_are_rejected() {
-    assert!(matches!(with(|p| p.dt = f64::NAN), Err(MeshError::NonFinite { name: "dt", .. })));
+    assert!(matches!(
+        with(|p| p.dt = f64::NAN),
+        Err(MeshError::NonFinite { name: "dt", .. })
+    ));
     assert!(matches!(
         with(|p| p.p0[1] = f64::INFINITY),
         Err(MeshError::NonFinite { name: "p0.y", .. })
@@ -34,7 +37,10 @@ fn non_finite_numbers_are_rejected() {
 #[test]
 fn a_direction_parallel_to_the_normal_is_rejected() {
     let e = with(|p| p.w00 = [0.0, 0.0, 2.0]).unwrap_err();
-    assert!(matches!(e, MeshError::DirectionParallelToNormal { .. }), "{e}");
+    assert!(
+        matches!(e, MeshError::DirectionParallelToNormal { .. }),
+        "{e}"
+    );
     assert!(e.to_string().contains("tangent plane"));
 }
 
@@ -66,9 +72,18 @@ fn a_non_positive_step_is_rejected() {
 
 #[test]
 fn growth_and_shrink_factors_must_grow_and_shrink() {
-    assert_eq!(with(|p| p.grow = 1.0).unwrap_err(), MeshError::GrowthFactor(1.0));
-    assert_eq!(with(|p| p.shrink = 1.0).unwrap_err(), MeshError::ShrinkFactor(1.0));
-    assert_eq!(with(|p| p.shrink = 0.0).unwrap_err(), MeshError::ShrinkFactor(0.0));
+    assert_eq!(
+        with(|p| p.grow = 1.0).unwrap_err(),
+        MeshError::GrowthFactor(1.0)
+    );
+    assert_eq!(
+        with(|p| p.shrink = 1.0).unwrap_err(),
+        MeshError::ShrinkFactor(1.0)
+    );
+    assert_eq!(
+        with(|p| p.shrink = 0.0).unwrap_err(),
+        MeshError::ShrinkFactor(0.0)
+    );
 }
 
 #[test]
@@ -101,7 +116,10 @@ fn too_few_previous_method_curves_are_rejected() {
 fn an_unsupported_output_extension_is_rejected() {
     let e = liemesh::io::MeshFormat::from_path(std::path::Path::new("mesh.xyz")).unwrap_err();
     let msg = e.to_string();
-    assert!(msg.contains(".ply") && msg.contains(".obj") && msg.contains(".stl"), "{msg}");
+    assert!(
+        msg.contains(".ply") && msg.contains(".obj") && msg.contains(".stl"),
+        "{msg}"
+    );
 }
 
 #[test]

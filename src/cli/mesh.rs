@@ -249,35 +249,46 @@ pub struct MeshOutcome {
     pub curves: usize,
     /// Wall-clock seconds of sampling and triangulation.
     pub seconds: f64,
+    /// The quality report, when asked for.
+    pub quality: Option<crate::quality::QualityReport>,
 }
 
-fn mesh_in<T: Scalar>(field: &LieField<T>, params: &MeshParams) -> Result<MeshOutcome, MeshError> {
+fn mesh_in<T: Scalar>(
+    invariant: &Invariant,
+    params: &MeshParams,
+    measure: bool,
+) -> Result<MeshOutcome, MeshError> {
+    let field = LieField::<T>::new(invariant);
     let start = Instant::now();
-    let run = crate::run(field, params)?;
+    let run = crate::run(&field, params)?;
+    let seconds = start.elapsed().as_secs_f64();
+    let quality = measure.then(|| {
+        crate::quality::QualityReport::measure(invariant, params, &run.samples, &run.mesh)
+    });
     Ok(MeshOutcome {
         curves: run.samples.curves.len(),
         mesh: run.mesh,
-        seconds: start.elapsed().as_secs_f64(),
+        seconds,
+        quality,
     })
 }
 
-/// Meshes `invariant` with `params` in the scalar type `scalar`.
+/// Meshes `invariant` with `params` in the scalar type `scalar`; with `measure`, also
+/// measures the mesh's quality.
 pub fn mesh_invariant(
     invariant: &Invariant,
     params: &MeshParams,
     scalar: ScalarKind,
+    measure: bool,
 ) -> Result<MeshOutcome, CliError> {
     Ok(match scalar {
-        ScalarKind::F32 => mesh_in(&LieField::<f32>::new(invariant), params)?,
-        ScalarKind::F64 => mesh_in(&LieField::<f64>::new(invariant), params)?,
-        ScalarKind::Dual => mesh_in(&LieField::<Dual<f64>>::new(invariant), params)?,
+        ScalarKind::F32 => mesh_in::<f32>(invariant, params, measure)?,
+        ScalarKind::F64 => mesh_in::<f64>(invariant, params, measure)?,
+        ScalarKind::Dual => mesh_in::<Dual<f64>>(invariant, params, measure)?,
         ScalarKind::Mpfr => {
             #[cfg(feature = "mpfr")]
             {
-                mesh_in(
-                    &LieField::<crate::scalar::Mpfr<256>>::new(invariant),
-                    params,
-                )?
+                mesh_in::<crate::scalar::Mpfr<256>>(invariant, params, measure)?
             }
             #[cfg(not(feature = "mpfr"))]
             {
@@ -296,7 +307,7 @@ pub(super) fn run(args: &MeshArgs) -> Result<ExitCode, CliError> {
         io::MeshFormat::from_path(out)?;
     }
     let scalar = ScalarKind::from(args.scalar);
-    let outcome = mesh_invariant(&invariant, &params, scalar)?;
+    let outcome = mesh_invariant(&invariant, &params, scalar, args.report.is_some())?;
     if let Some(out) = &args.output {
         io::write_mesh(
             &outcome.mesh,
@@ -309,7 +320,7 @@ pub(super) fn run(args: &MeshArgs) -> Result<ExitCode, CliError> {
     if let Some(png) = &args.png {
         crate::io::render::render_to_file(&outcome.mesh, png, &args.picture.options())?;
     }
-    let report = Report::new(
+    let mut report = Report::new(
         preset.map(|p| p.name().to_string()),
         &invariant,
         scalar,
@@ -318,6 +329,7 @@ pub(super) fn run(args: &MeshArgs) -> Result<ExitCode, CliError> {
         outcome.seconds,
         &params,
     );
+    report.quality = outcome.quality.clone();
     if let Some(path) = &args.report {
         write_json(path, &report)?;
     }

@@ -3,7 +3,11 @@
 //! Exit codes: 0 success, 1 a check failed (e.g. an audit row), 2 bad input or an error
 //! (the message on standard error says what was wrong and what to do).
 
+mod audit;
+mod bench;
 mod mesh;
+mod paper;
+mod quality;
 mod render;
 
 use clap::{Parser, Subcommand};
@@ -22,12 +26,24 @@ pub struct Cli {
 }
 
 /// The subcommands.
+// Parsed once per process: the size of the `Mesh` variant does not matter.
+#[allow(clippy::large_enum_variant)]
 #[derive(Debug, Subcommand)]
 pub enum Command {
     /// Mesh a preset or an invariant file and write the mesh (and a report).
     Mesh(MeshArgs),
+    /// Run the accuracy audits (AD prediction order, JVPs, scalar agreement) and print a table.
+    Audit(audit::AuditArgs),
     /// Draw a mesh file as a wireframe picture (.png or .svg).
     Render(render::RenderArgs),
+    /// Measure fig1..fig6 in both modes and print the quality table.
+    Quality(quality::QualityArgs),
+    /// Recover the invariant from a mesh file alone (vertex positions and face normals).
+    Recover(quality::RecoverArgs),
+    /// Reproduce the paper: fig1..fig6 meshes and pictures, and Table 3 side by side.
+    Paper(paper::PaperArgs),
+    /// Time the performance workloads (issue 6) and print a table or JSON.
+    Bench(bench::BenchArgs),
 }
 
 /// Any error the command line reports (exit code 2).
@@ -74,7 +90,12 @@ pub fn main() -> ExitCode {
 pub fn run(cli: Cli) -> Result<ExitCode, CliError> {
     match cli.command {
         Some(Command::Mesh(args)) => mesh::run(&args),
+        Some(Command::Audit(args)) => audit::run(&args),
         Some(Command::Render(args)) => render::run(&args),
+        Some(Command::Quality(args)) => quality::run(&args),
+        Some(Command::Recover(args)) => quality::recover_cmd(&args),
+        Some(Command::Bench(args)) => bench::run(&args),
+        Some(Command::Paper(args)) => paper::run(&args),
         None => mesh::run(&MeshArgs::default_job()),
     }
 }

@@ -36,6 +36,8 @@ pub struct Report {
     pub seconds: f64,
     /// The parameters used.
     pub parameters: MeshParams,
+    /// Quality measures (shape, fidelity, topology, recovered invariant), when measured.
+    pub quality: Option<crate::quality::QualityReport>,
 }
 
 impl Report {
@@ -64,6 +66,7 @@ impl Report {
             topology,
             seconds,
             parameters: parameters.clone(),
+            quality: None,
         }
     }
 }

@@ -105,6 +105,14 @@ impl<T: Scalar> Samples<T> {
 /// to a point that lies far away in the chart.
 const COLLISION_RADIUS: f64 = 0.6;
 
+/// Curves are advanced in order of arc length measured in units of `dt_min / ORDER_RESOLUTION`
+/// (ties by curve id), not of the exact `f64` arc length: curves that symmetry gives equal arc
+/// lengths (every curve on the sphere) would otherwise be ordered by rounding noise, and the
+/// order decides insertions, merges and collisions, so `f32`, `f64` and MPFR runs would make
+/// different discrete decisions. The quantum is far above the rounding noise of the arc length
+/// in every supported scalar type (≈1e-7 in `f32`) and far below the smallest step.
+const ORDER_RESOLUTION: f64 = 64.0;
+
 struct Live<T> {
     p: Vec3<T>,
     carry: Vec3<T>,
@@ -195,7 +203,7 @@ pub fn sample<T: Scalar, F: NormalField<T>>(
             right: (j + 1) % n,
             active: true,
         });
-        s.heap.push(Reverse((0.0f64.to_bits(), j)));
+        s.heap.push(Reverse((s.order_key(0.0), j)));
     }
     s.run();
     let Sampler { mut out, .. } = s;
@@ -236,6 +244,11 @@ fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
 }
 
 impl<T: Scalar, F: NormalField<T>> Sampler<'_, T, F> {
+    /// The heap key of a curve at arc length `s` (see [`ORDER_RESOLUTION`]).
+    fn order_key(&self, s: f64) -> u64 {
+        (s * ORDER_RESOLUTION / self.params.dt_min).floor() as u64
+    }
+
     fn run(&mut self) {
         let budget = &self.params.budget;
         // Every pass either adds a point or ends a curve, so this bound is never the binding
@@ -249,7 +262,7 @@ impl<T: Scalar, F: NormalField<T>> Sampler<'_, T, F> {
                 self.end_curve(c, end);
             } else {
                 let s = self.live[c as usize].s;
-                self.heap.push(Reverse((s.to_bits(), c)));
+                self.heap.push(Reverse((self.order_key(s), c)));
             }
         }
         // Budget exhausted: end what is still running.
@@ -335,7 +348,19 @@ impl<T: Scalar, F: NormalField<T>> Sampler<'_, T, F> {
         live.s = s_new;
 
         if proposed {
+            // With two curves left alive both sides face the same neighbour, but the gap is
+            // on one side only (the narrower in θ): inserting on both would put two curves on
+            // the same start point.
+            let (l, r) = (self.live[ci].left, self.live[ci].right);
+            let ring_of_two = l == r && l != c;
+            let right_narrower = {
+                let (tc, tk) = (theta, self.out.curves[r as usize].theta);
+                (tk - tc).rem_euclid(std::f64::consts::TAU) <= std::f64::consts::PI
+            };
             for side_right in [true, false] {
+                if ring_of_two && side_right != right_narrower {
+                    continue;
+                }
                 let live = &self.live[ci];
                 let k = if side_right { live.right } else { live.left };
                 if k == c || self.out.curves.len() >= budget.max_curves {
@@ -457,6 +482,11 @@ impl<T: Scalar, F: NormalField<T>> Sampler<'_, T, F> {
         };
         let start_f = start.to_f64();
         let s = 0.5 * (self.live[c as usize].s + s_target);
+        // The terminal conditions hold for inserted points as for stepped ones.
+        let bb = self.params.terminal.bounding_box;
+        if s > self.params.terminal.max_radius || start_f.iter().any(|x| x.abs() > bb) {
+            return;
+        }
         let chart = [s * theta.cos(), s * theta.sin()];
         if self.params.terminal.close && self.collides(start_f, chart, len) {
             return;
@@ -495,6 +525,6 @@ impl<T: Scalar, F: NormalField<T>> Sampler<'_, T, F> {
         });
         self.live[left as usize].right = id;
         self.live[right as usize].left = id;
-        self.heap.push(Reverse((s.to_bits(), id)));
+        self.heap.push(Reverse((self.order_key(s), id)));
     }
 }

@@ -104,7 +104,8 @@ pub(crate) fn flip_to_surface_delaunay(
         let old2 = [b, a, d];
         let new1 = [a, d, c];
         let new2 = [d, b, c];
-        let new_ok = agreement(points, normals, new1) > 0.0 && agreement(points, normals, new2) > 0.0;
+        let new_ok =
+            agreement(points, normals, new1) > 0.0 && agreement(points, normals, new2) > 0.0;
         if !new_ok {
             continue;
         }
@@ -116,12 +117,14 @@ pub(crate) fn flip_to_surface_delaunay(
         if dot(face_normal(points, new1), old_sum) <= 0.0
             || dot(face_normal(points, new2), old_sum) <= 0.0
         {
-            let folded = agreement(points, normals, old1) <= 0.0 || agreement(points, normals, old2) <= 0.0;
+            let folded =
+                agreement(points, normals, old1) <= 0.0 || agreement(points, normals, old2) <= 0.0;
             if !folded {
                 continue;
             }
         }
-        let folded = agreement(points, normals, old1) <= 0.0 || agreement(points, normals, old2) <= 0.0;
+        let folded =
+            agreement(points, normals, old1) <= 0.0 || agreement(points, normals, old2) <= 0.0;
         let delaunay_violation =
             angle_at(pc, pa, pb) + angle_at(pd, pb, pa) > std::f64::consts::PI + 1e-12;
         if !(folded || delaunay_violation) {

@@ -9,10 +9,14 @@
 //!    the two charts are stitched edge to edge and the mesh is watertight.
 //! 3. Triangles are counter-clockwise in both charts, whose frames are right-handed about the
 //!    field normal: every triangle is oriented with the field normal.
-//! 4. In the default mode, edge flips make the result Delaunay on the surface itself.
+//! 4. In the default mode, edge flips make the result Delaunay on the surface itself, and a
+//!    tangential relaxation along the surface evens out the triangles.
 
 mod flip;
 mod mesh;
+mod relax;
+
+pub(crate) use relax::relax;
 
 pub use mesh::{Mesh, Provenance};
 

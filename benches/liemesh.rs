@@ -1,0 +1,136 @@
+//! Criterion benchmarks of issue 6: (a) the six presets end to end, (b) sphere and
+//! ellipsoid at about 10^4 and 10^5 triangles split into sampling and triangulation,
+//! (c) fig6 sampling per scalar type, (d) spade's bulk load of the same chart points.
+//! The 10^6-triangle workloads are only in `liemesh bench`.
+
+use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
+use liemesh::model::{Invariant, LieField};
+use liemesh::preset::Preset;
+use liemesh::scalar::Dual;
+use liemesh::MeshParams;
+use spade::Triangulation as _;
+use std::hint::black_box;
+use std::time::Duration;
+
+/// Same scaling as `liemesh bench`: β band (and Δt) shrunk by √(target / base).
+fn workload(ellipsoid: bool, target: usize) -> (Invariant, MeshParams) {
+    let numbers: [f64; 6] = if ellipsoid {
+        [1.0, 4.0, 16.0, 0.0, 0.0, 0.0]
+    } else {
+        [1.0, 1.0, 1.0, 0.0, 0.0, 0.0]
+    };
+    let invariant = Invariant::from_numbers(&numbers).unwrap();
+    let mut params = Preset::Fig3.params();
+    let base = if ellipsoid { 9000.0 } else { 2000.0 };
+    let s = (target as f64 / base).sqrt();
+    params.beta_min /= s;
+    params.beta_max /= s;
+    params.dt /= s;
+    params.p0 = if ellipsoid {
+        [0.0, 0.0, 0.25]
+    } else {
+        [0.0, 0.0, 1.0]
+    };
+    (invariant, params)
+}
+
+fn configure<'a>(
+    c: &'a mut Criterion,
+    name: &str,
+) -> criterion::BenchmarkGroup<'a, criterion::measurement::WallTime> {
+    let mut g = c.benchmark_group(name);
+    g.sample_size(10)
+        .measurement_time(Duration::from_secs(2))
+        .warm_up_time(Duration::from_millis(500));
+    g
+}
+
+fn presets(c: &mut Criterion) {
+    let mut g = configure(c, "presets");
+    for preset in Preset::ALL {
+        let field = LieField::<f64>::new(&preset.invariant());
+        let params = preset.params();
+        let triangles = liemesh::run(&field, &params).unwrap().mesh.triangles.len();
+        g.throughput(Throughput::Elements(triangles as u64));
+        g.bench_function(preset.name(), |b| {
+            b.iter(|| liemesh::run(black_box(&field), &params).unwrap())
+        });
+    }
+    g.finish();
+}
+
+fn sizes(c: &mut Criterion) {
+    let mut g = configure(c, "surfaces");
+    for (ellipsoid, label) in [(false, "sphere"), (true, "ellipsoid")] {
+        for (target, tag) in [(10_000, "1e4"), (100_000, "1e5")] {
+            let (inv, params) = workload(ellipsoid, target);
+            let field = LieField::<f64>::new(&inv);
+            let samples = liemesh::sample::sample(&field, &params).unwrap();
+            let (mesh, _) = liemesh::triangulate::triangulate(&samples, true, true).unwrap();
+            g.throughput(Throughput::Elements(mesh.triangles.len() as u64));
+            let id = format!("{label}-{tag}");
+            g.bench_function(BenchmarkId::new("sample", &id), |b| {
+                b.iter(|| liemesh::sample::sample(black_box(&field), &params).unwrap())
+            });
+            g.bench_function(BenchmarkId::new("triangulate", &id), |b| {
+                b.iter(|| {
+                    liemesh::triangulate::triangulate(black_box(&samples), true, true).unwrap()
+                })
+            });
+            let chart: Vec<spade::Point2<f64>> = (0..samples.points.len())
+                .map(|i| {
+                    let p = samples.chart(i);
+                    spade::Point2::new(p[0], p[1])
+                })
+                .collect();
+            g.bench_function(BenchmarkId::new("spade_bulk_load", &id), |b| {
+                b.iter(|| {
+                    spade::DelaunayTriangulation::<spade::Point2<f64>>::bulk_load(black_box(
+                        chart.clone(),
+                    ))
+                    .unwrap()
+                })
+            });
+        }
+    }
+    g.finish();
+}
+
+fn scalars(c: &mut Criterion) {
+    let mut g = configure(c, "fig6_sampling");
+    let inv = Preset::Fig6.invariant();
+    let params = Preset::Fig6.params();
+    let f64_field = LieField::<f64>::new(&inv);
+    let n = liemesh::sample::sample(&f64_field, &params)
+        .unwrap()
+        .points
+        .len();
+    g.throughput(Throughput::Elements(n as u64));
+    let f32_field = LieField::<f32>::new(&inv);
+    g.bench_function("f32", |b| {
+        b.iter(|| liemesh::sample::sample(black_box(&f32_field), &params).unwrap())
+    });
+    g.bench_function("f64", |b| {
+        b.iter(|| liemesh::sample::sample(black_box(&f64_field), &params).unwrap())
+    });
+    let dual_field = LieField::<Dual<f64>>::new(&inv);
+    g.bench_function("dual_f64", |b| {
+        b.iter(|| liemesh::sample::sample(black_box(&dual_field), &params).unwrap())
+    });
+    #[cfg(feature = "mpfr")]
+    {
+        use liemesh::scalar::Mpfr;
+        let m64 = LieField::<Mpfr<64>>::new(&inv);
+        g.bench_function("mpfr64", |b| {
+            b.iter(|| liemesh::sample::sample(black_box(&m64), &params).unwrap())
+        });
+        let m256 = LieField::<Mpfr<256>>::new(&inv);
+        g.bench_function("mpfr256", |b| {
+            b.iter(|| liemesh::sample::sample(black_box(&m256), &params).unwrap())
+        });
+    }
+    g.finish();
+}
+
+criterion_group!(benches, presets, sizes, scalars);
+criterion_main!(benches);

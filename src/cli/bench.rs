@@ -1,0 +1,299 @@
+//! `liemesh bench`: the performance workloads of issue 6, timed once each (medians of a
+//! few repeats for the small ones), as a table or JSON.
+
+use super::CliError;
+use crate::model::{Invariant, LieField, NormalField};
+use crate::preset::Preset;
+use crate::scalar::{Dual, Scalar};
+use crate::{MeshParams, Mode};
+use clap::Args;
+use serde::Serialize;
+use spade::Triangulation as _;
+use std::process::ExitCode;
+use std::time::Instant;
+
+/// Arguments of `liemesh bench`.
+#[derive(Debug, Clone, Args)]
+pub struct BenchArgs {
+    /// Print JSON instead of a table.
+    #[arg(long)]
+    pub json: bool,
+    /// Skip the ~10^6-triangle workloads.
+    #[arg(long)]
+    pub quick: bool,
+    /// Only tiny workloads (~10^3 triangles, one repeat; for tests).
+    #[arg(long)]
+    pub tiny: bool,
+}
+
+/// One timed workload.
+#[derive(Debug, Clone, Serialize)]
+pub struct WorkloadRow {
+    /// Name, e.g. `sphere-1e5`.
+    pub workload: String,
+    /// Triangles of the mesh.
+    pub triangles: usize,
+    /// Sample points.
+    pub points: usize,
+    /// Sampling, ns per triangle.
+    pub sample_ns_per_tri: f64,
+    /// Triangulation (chart Delaunay, flips, closing, assembly), ns per triangle.
+    pub triangulate_ns_per_tri: f64,
+    /// Sampling + triangulation, ns per triangle.
+    pub total_ns_per_tri: f64,
+    /// spade's bulk load of the same chart points, ns per triangle.
+    pub spade_ns_per_tri: f64,
+    /// Total ÷ spade-only.
+    pub total_over_spade: f64,
+}
+
+/// The ratios issue 6 asks for.
+#[derive(Debug, Clone, Serialize)]
+pub struct Ratios {
+    /// fig6 sampling in Dual<f64> ÷ in f64.
+    pub dual_over_f64: f64,
+    /// fig6 sampling in Mpfr<256> ÷ in f64 (only with the `mpfr` feature).
+    pub mpfr256_over_f64: Option<f64>,
+    /// Sphere: ns/triangle at the largest size ÷ at the smallest.
+    pub sphere_scaling: f64,
+    /// Ellipsoid: ns/triangle at the largest size ÷ at the smallest.
+    pub ellipsoid_scaling: f64,
+}
+
+/// The whole report.
+#[derive(Debug, Clone, Serialize)]
+pub struct BenchReport {
+    /// Timed workloads.
+    pub rows: Vec<WorkloadRow>,
+    /// fig6 sampling times in ms per scalar type.
+    pub fig6_sampling_ms: Vec<(String, f64)>,
+    /// The ratios.
+    pub ratios: Ratios,
+}
+
+/// Parameters for the sphere (`ellipsoid = false`) or the ellipsoid `(1, 4, 16, 0, 0, 0)`
+/// meshed by the proposed method with the β band scaled so that the sphere gets roughly
+/// `target` triangles (fig3 gives about 2000 at β ∈ [4°, 8°]; count ∝ 1/β²).
+pub fn workload_params(ellipsoid: bool, target: usize) -> (Invariant, MeshParams) {
+    let numbers: [f64; 6] = if ellipsoid {
+        [1.0, 4.0, 16.0, 0.0, 0.0, 0.0]
+    } else {
+        [1.0, 1.0, 1.0, 0.0, 0.0, 0.0]
+    };
+    let invariant = Invariant::from_numbers(&numbers).expect("valid invariant");
+    let mut params = Preset::Fig3.params();
+    // The ellipsoid gets about 4.6 times the sphere's count at the same β band.
+    let base = if ellipsoid { 9000.0 } else { 2000.0 };
+    let s = (target as f64 / base).sqrt();
+    params.beta_min /= s;
+    params.beta_max /= s;
+    params.dt /= s;
+    params.p0 = if ellipsoid {
+        [0.0, 0.0, 0.25]
+    } else {
+        [0.0, 0.0, 1.0]
+    };
+    (invariant, params)
+}
+
+fn median(mut v: Vec<f64>) -> f64 {
+    v.sort_by(f64::total_cmp);
+    v[v.len() / 2]
+}
+
+fn time_workload(
+    name: &str,
+    invariant: &Invariant,
+    params: &MeshParams,
+    repeats: usize,
+) -> Result<WorkloadRow, CliError> {
+    let field = LieField::<f64>::new(invariant);
+    let improve = params.mode == Mode::Default;
+    let (mut ts, mut tt, mut tb) = (Vec::new(), Vec::new(), Vec::new());
+    let (mut triangles, mut points) = (0, 0);
+    for _ in 0..repeats {
+        let t0 = Instant::now();
+        let samples = crate::sample::sample(&field, params)?;
+        let t1 = Instant::now();
+        let (mesh, _) = crate::triangulate::triangulate(&samples, params.terminal.close, improve)?;
+        let t2 = Instant::now();
+        let chart: Vec<spade::Point2<f64>> = (0..samples.points.len())
+            .map(|i| {
+                let c = samples.chart(i);
+                spade::Point2::new(c[0], c[1])
+            })
+            .collect();
+        let t3 = Instant::now();
+        let dt = spade::DelaunayTriangulation::<spade::Point2<f64>>::bulk_load(chart)
+            .map_err(|e| CliError::Usage(format!("spade bulk load failed: {e:?}")))?;
+        let t4 = Instant::now();
+        std::hint::black_box(dt);
+        ts.push((t1 - t0).as_secs_f64());
+        tt.push((t2 - t1).as_secs_f64());
+        tb.push((t4 - t3).as_secs_f64());
+        triangles = mesh.triangles.len();
+        points = samples.points.len();
+    }
+    let per = 1e9 / triangles.max(1) as f64;
+    let (s, t, b) = (median(ts) * per, median(tt) * per, median(tb) * per);
+    Ok(WorkloadRow {
+        workload: name.to_string(),
+        triangles,
+        points,
+        sample_ns_per_tri: s,
+        triangulate_ns_per_tri: t,
+        total_ns_per_tri: s + t,
+        spade_ns_per_tri: b,
+        total_over_spade: (s + t) / b,
+    })
+}
+
+fn time_sampling<T: Scalar, F: NormalField<T>>(
+    field: &F,
+    params: &MeshParams,
+    repeats: usize,
+) -> Result<f64, CliError> {
+    let mut v = Vec::new();
+    std::hint::black_box(crate::sample::sample(field, params)?); // warm-up
+    for _ in 0..repeats {
+        let t0 = Instant::now();
+        std::hint::black_box(crate::sample::sample(field, params)?);
+        v.push(t0.elapsed().as_secs_f64() * 1e3);
+    }
+    Ok(median(v))
+}
+
+/// Runs every workload and collects the report.
+pub fn measure(args: &BenchArgs) -> Result<BenchReport, CliError> {
+    let mut rows = Vec::new();
+    let repeats = if args.tiny { 3 } else { 5 };
+    for preset in Preset::ALL {
+        let field_inv = preset.invariant();
+        rows.push(time_workload(
+            preset.name(),
+            &field_inv,
+            &preset.params(),
+            repeats,
+        )?);
+    }
+    let sizes: Vec<(usize, &str, usize)> = if args.tiny {
+        vec![(1_000, "1e3", 1), (4_000, "4e3", 1)]
+    } else if args.quick {
+        vec![(10_000, "1e4", 5), (100_000, "1e5", 3)]
+    } else {
+        vec![
+            (10_000, "1e4", 5),
+            (100_000, "1e5", 3),
+            (1_000_000, "1e6", 1),
+        ]
+    };
+    let mut scaling = [0.0; 2];
+    for (k, (ellipsoid, label)) in [(false, "sphere"), (true, "ellipsoid")]
+        .into_iter()
+        .enumerate()
+    {
+        let mut first = None;
+        let mut last = 0.0;
+        for &(target, tag, rep) in &sizes {
+            let (inv, params) = workload_params(ellipsoid, target);
+            let row = time_workload(&format!("{label}-{tag}"), &inv, &params, rep)?;
+            first.get_or_insert(row.total_ns_per_tri);
+            last = row.total_ns_per_tri;
+            rows.push(row);
+        }
+        scaling[k] = last / first.unwrap_or(1.0);
+    }
+    let inv = Preset::Fig6.invariant();
+    let params = Preset::Fig6.params();
+    let rep = if args.tiny { 3 } else { 7 };
+    #[allow(unused_mut)]
+    let mut fig6 = vec![
+        (
+            "f32".to_string(),
+            time_sampling(&LieField::<f32>::new(&inv), &params, rep)?,
+        ),
+        (
+            "f64".to_string(),
+            time_sampling(&LieField::<f64>::new(&inv), &params, rep)?,
+        ),
+        (
+            "dual".to_string(),
+            time_sampling(&LieField::<Dual<f64>>::new(&inv), &params, rep)?,
+        ),
+    ];
+    #[cfg(feature = "mpfr")]
+    let mpfr256_over_f64 = {
+        use crate::scalar::Mpfr;
+        let r = rep.min(3);
+        let m64 = time_sampling(&LieField::<Mpfr<64>>::new(&inv), &params, r)?;
+        let m256 = time_sampling(&LieField::<Mpfr<256>>::new(&inv), &params, r)?;
+        fig6.push(("mpfr64".to_string(), m64));
+        fig6.push(("mpfr256".to_string(), m256));
+        Some(m256 / fig6[1].1)
+    };
+    #[cfg(not(feature = "mpfr"))]
+    let mpfr256_over_f64 = None;
+    let ratios = Ratios {
+        dual_over_f64: fig6[2].1 / fig6[1].1,
+        mpfr256_over_f64,
+        sphere_scaling: scaling[0],
+        ellipsoid_scaling: scaling[1],
+    };
+    Ok(BenchReport {
+        rows,
+        fig6_sampling_ms: fig6,
+        ratios,
+    })
+}
+
+/// `liemesh bench`.
+pub fn run(args: &BenchArgs) -> Result<ExitCode, CliError> {
+    let report = measure(args)?;
+    if args.json {
+        println!(
+            "{}",
+            serde_json::to_string_pretty(&report).expect("report serializes")
+        );
+        return Ok(ExitCode::SUCCESS);
+    }
+    println!(
+        "{:<14} {:>9} {:>9} {:>10} {:>10} {:>10} {:>10} {:>8}",
+        "workload", "triangles", "points", "sample", "triang.", "total", "spade", "tot/spd"
+    );
+    println!(
+        "{:<14} {:>9} {:>9} {:>10} {:>10} {:>10} {:>10}",
+        "", "", "", "ns/tri", "ns/tri", "ns/tri", "ns/tri"
+    );
+    for r in &report.rows {
+        println!(
+            "{:<14} {:>9} {:>9} {:>10.1} {:>10.1} {:>10.1} {:>10.1} {:>8.2}",
+            r.workload,
+            r.triangles,
+            r.points,
+            r.sample_ns_per_tri,
+            r.triangulate_ns_per_tri,
+            r.total_ns_per_tri,
+            r.spade_ns_per_tri,
+            r.total_over_spade
+        );
+    }
+    println!();
+    for (name, ms) in &report.fig6_sampling_ms {
+        println!("fig6 sampling {name:<8} {ms:>10.3} ms");
+    }
+    let r = &report.ratios;
+    println!();
+    println!("Dual<f64> / f64 sampling     {:.2}", r.dual_over_f64);
+    if let Some(m) = r.mpfr256_over_f64 {
+        println!("Mpfr<256> / f64 sampling     {m:.1}");
+    }
+    println!(
+        "sphere    ns/tri largest / smallest  {:.2}",
+        r.sphere_scaling
+    );
+    println!(
+        "ellipsoid ns/tri largest / smallest  {:.2}",
+        r.ellipsoid_scaling
+    );
+    Ok(ExitCode::SUCCESS)
+}

@@ -1,0 +1,278 @@
+//! Invariants recovered from a mesh alone (the paper's notion of quality).
+//!
+//! Vertex normals are estimated from the mesh (face normals with Max's weights, never the
+//! stored field normals). Since `n ∥ A p + B (p∘p)`, each vertex gives three equations
+//! `n × (A p + B (p∘p)) = 0` that are linear in the entries of `A` (and `B`); the least-squares
+//! solution of unit norm is the right singular vector of the smallest singular value. It is
+//! scaled to the reference by least squares and decomposed as `A = diag(λ) Rx(θ) Ry(φ) Rz(ψ)`.
+
+use crate::model::Invariant;
+use crate::triangulate::Mesh;
+use nalgebra::{DMatrix, Matrix3};
+use serde::{Deserialize, Serialize};
+
+/// What was recovered.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Recovery {
+    /// Recovered `A` (row-major), scaled to the reference when one was given, else to unit
+    /// Frobenius norm of `[A B]`.
+    pub a: [[f64; 3]; 3],
+    /// Recovered `B` (zero for the linear model).
+    pub b: [[f64; 3]; 3],
+    /// `(λ1, λ2, λ3, θ, φ, ψ)` of the recovered `A`.
+    pub a_invariant: [f64; 6],
+    /// RMS of the equations' residual at unit norm (0 when some field fits every vertex
+    /// normal exactly).
+    pub residual: f64,
+    /// `‖[A B]_recovered − [A B]_reference‖ / ‖[A B]_reference‖`, when a reference was given.
+    pub relative_error: Option<f64>,
+}
+
+/// Vertex normals of `mesh` from its faces alone (unit; zero where undefined), with Max's
+/// weights: each face contributes `(e₁ × e₂) / (|e₁|² |e₂|²)` for its two edges at the vertex,
+/// which is exact for vertices on a sphere and second-order accurate on smooth surfaces,
+/// where plain area weights are only first-order on irregular meshes.
+pub fn mesh_normals(mesh: &Mesh) -> Vec<[f64; 3]> {
+    let mut acc = vec![[0.0; 3]; mesh.vertices.len()];
+    for t in &mesh.triangles {
+        for k in 0..3 {
+            let v = t[k] as usize;
+            let p = mesh.vertices[v];
+            let a = mesh.vertices[t[(k + 1) % 3] as usize];
+            let b = mesh.vertices[t[(k + 2) % 3] as usize];
+            let u = [a[0] - p[0], a[1] - p[1], a[2] - p[2]];
+            let w = [b[0] - p[0], b[1] - p[1], b[2] - p[2]];
+            let n = [
+                u[1] * w[2] - u[2] * w[1],
+                u[2] * w[0] - u[0] * w[2],
+                u[0] * w[1] - u[1] * w[0],
+            ];
+            let uu = u[0] * u[0] + u[1] * u[1] + u[2] * u[2];
+            let ww = w[0] * w[0] + w[1] * w[1] + w[2] * w[2];
+            let weight = uu * ww;
+            if weight > 0.0 {
+                for c in 0..3 {
+                    acc[v][c] += n[c] / weight;
+                }
+            }
+        }
+    }
+    acc.into_iter()
+        .map(|n| {
+            let l = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
+            if l > 0.0 {
+                [n[0] / l, n[1] / l, n[2] / l]
+            } else {
+                [0.0; 3]
+            }
+        })
+        .collect()
+}
+
+/// Fits the field to `mesh`; `hamiltonian` adds the 9 entries of `B`. With a `reference`
+/// invariant, the fit is scaled to it and its relative error reported.
+pub fn recover(mesh: &Mesh, hamiltonian: bool, reference: Option<&Invariant>) -> Recovery {
+    let normals = mesh_normals(mesh);
+    let unknowns = if hamiltonian { 18 } else { 9 };
+    let used: Vec<usize> = (0..mesh.vertices.len())
+        .filter(|&i| normals[i] != [0.0; 3])
+        .collect();
+    // Scale points to O(1) for conditioning; A and B are rescaled back below.
+    let scale = used
+        .iter()
+        .map(|&i| mesh.vertices[i].iter().fold(0.0_f64, |m, x| m.max(x.abs())))
+        .fold(0.0_f64, f64::max)
+        .max(1e-300);
+    // Each vertex stands for a third of its faces' area, so that the fit measures the
+    // surface, not the sampling density.
+    let mut area = vec![0.0; mesh.vertices.len()];
+    for t in &mesh.triangles {
+        let [a, b, c] = t.map(|i| mesh.vertices[i as usize]);
+        let u = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
+        let w = [c[0] - a[0], c[1] - a[1], c[2] - a[2]];
+        let n = [
+            u[1] * w[2] - u[2] * w[1],
+            u[2] * w[0] - u[0] * w[2],
+            u[0] * w[1] - u[1] * w[0],
+        ];
+        let third = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt() / 6.0;
+        for &i in t {
+            area[i as usize] += third;
+        }
+    }
+    let points: Vec<([f64; 3], [f64; 3])> = used
+        .iter()
+        .map(|&i| {
+            let p = mesh.vertices[i].map(|x| x / scale);
+            (p, p.map(|x| x * x))
+        })
+        .collect();
+    let solve = |weights: &[f64]| {
+        let mut m = DMatrix::<f64>::zeros(3 * used.len(), unknowns);
+        for (row, &i) in used.iter().enumerate() {
+            let (p, q) = points[row];
+            let n = normals[i];
+            let wt = weights[row];
+            // (n × (A p))_r = Σ_jk ε_rjk n_j (A p)_k; (A p)_k = Σ_l A_kl p_l.
+            for r in 0..3 {
+                let (j, k) = ((r + 1) % 3, (r + 2) % 3);
+                for l in 0..3 {
+                    // + n_j A_kl p_l − n_k A_jl p_l
+                    m[(3 * row + r, 3 * k + l)] += wt * n[j] * p[l];
+                    m[(3 * row + r, 3 * j + l)] -= wt * n[k] * p[l];
+                    if hamiltonian {
+                        m[(3 * row + r, 9 + 3 * k + l)] += wt * n[j] * q[l];
+                        m[(3 * row + r, 9 + 3 * j + l)] -= wt * n[k] * q[l];
+                    }
+                }
+            }
+        }
+        // Normal equations MᵀM (unknowns × unknowns) keep the eigenproblem small.
+        let eig = (m.transpose() * &m).symmetric_eigen();
+        let (imin, &lmin) = eig
+            .eigenvalues
+            .iter()
+            .enumerate()
+            .min_by(|a, b| a.1.total_cmp(b.1))
+            .expect("at least 9 unknowns");
+        (eig.eigenvectors.column(imin).clone_owned(), lmin)
+    };
+    let total_area: f64 = used.iter().map(|&i| area[i]).sum::<f64>().max(1e-300);
+    let _ = total_area;
+    let area_weights: Vec<f64> = used.iter().map(|_| 1.0).collect();
+    let (first, _) = solve(&area_weights);
+    // Second pass: divide each equation by |v(p)| of the first fit, so that every vertex
+    // contributes the sine of its normal's angle error, whatever the field's magnitude.
+    let field_norm = |row: usize| {
+        let (p, q) = points[row];
+        let mut v = [0.0; 3];
+        for r in 0..3 {
+            for l in 0..3 {
+                v[r] += first[3 * r + l] * p[l];
+                if hamiltonian {
+                    v[r] += first[9 + 3 * r + l] * q[l];
+                }
+            }
+        }
+        (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt()
+    };
+    let weights: Vec<f64> = (0..used.len())
+        .map(|row| {
+            let f = field_norm(row);
+            if f > 0.0 {
+                area_weights[row] / f
+            } else {
+                0.0
+            }
+        })
+        .collect();
+    let (x, lmin) = solve(&weights);
+    // RMS angle residual (the weights sum to one over the area).
+    let residual = lmin.max(0.0).sqrt();
+    let mut a = [[0.0; 3]; 3];
+    let mut b = [[0.0; 3]; 3];
+    for r in 0..3 {
+        for c in 0..3 {
+            a[r][c] = x[3 * r + c];
+            if hamiltonian {
+                // B multiplies p∘p = scale² (p/scale)∘(p/scale): undo against A's single scale.
+                b[r][c] = x[9 + 3 * r + c] / scale;
+            }
+        }
+    }
+    let flat = |a: &[[f64; 3]; 3], b: &[[f64; 3]; 3]| -> Vec<f64> {
+        a.iter()
+            .flatten()
+            .chain(b.iter().flatten())
+            .copied()
+            .collect()
+    };
+    let mut relative_error = None;
+    let fit = flat(&a, &b);
+    let k = match reference {
+        Some(inv) => {
+            let ra = inv.a_matrix::<f64>().map(|r| r.to_f64());
+            let rb = if hamiltonian {
+                inv.b_matrix::<f64>().map(|r| r.to_f64())
+            } else {
+                [[0.0; 3]; 3]
+            };
+            let refv = flat(&ra, &rb);
+            let dot: f64 = fit.iter().zip(&refv).map(|(x, y)| x * y).sum();
+            let ff: f64 = fit.iter().map(|x| x * x).sum();
+            let rr: f64 = refv.iter().map(|x| x * x).sum();
+            let k = if ff > 0.0 { dot / ff } else { 0.0 };
+            let err: f64 = fit
+                .iter()
+                .zip(&refv)
+                .map(|(x, y)| (k * x - y).powi(2))
+                .sum();
+            relative_error = Some((err / rr.max(1e-300)).sqrt());
+            k
+        }
+        None => {
+            let ff: f64 = fit.iter().map(|x| x * x).sum::<f64>().sqrt();
+            if ff > 0.0 {
+                1.0 / ff
+            } else {
+                0.0
+            }
+        }
+    };
+    for r in 0..3 {
+        for c in 0..3 {
+            a[r][c] *= k;
+            b[r][c] *= k;
+        }
+    }
+    Recovery {
+        a_invariant: decompose(&a),
+        a,
+        b,
+        residual,
+        relative_error,
+    }
+}
+
+/// `A = diag(λ) Rx(θ) Ry(φ) Rz(ψ)` → `(λ1, λ2, λ3, θ, φ, ψ)`, with `λ` signs chosen so that
+/// the rotation has determinant +1 and the first non-zero λ is positive when both work.
+pub fn decompose(a: &[[f64; 3]; 3]) -> [f64; 6] {
+    let mut lambda = [0.0; 3];
+    let mut r = Matrix3::<f64>::zeros();
+    for i in 0..3 {
+        let n = (a[i][0].powi(2) + a[i][1].powi(2) + a[i][2].powi(2)).sqrt();
+        lambda[i] = n;
+        for j in 0..3 {
+            r[(i, j)] = if n > 0.0 { a[i][j] / n } else { 0.0 };
+        }
+    }
+    if r.determinant() < 0.0 {
+        // Flip the sign of the row with the smallest λ (least visible).
+        let i = (0..3)
+            .min_by(|&x, &y| lambda[x].total_cmp(&lambda[y]))
+            .unwrap();
+        lambda[i] = -lambda[i];
+        for j in 0..3 {
+            r[(i, j)] = -r[(i, j)];
+        }
+    }
+    let phi = r[(0, 2)].clamp(-1.0, 1.0).asin();
+    let psi = (-r[(0, 1)]).atan2(r[(0, 0)]);
+    let theta = (-r[(1, 2)]).atan2(r[(2, 2)]);
+    [lambda[0], lambda[1], lambda[2], theta, phi, psi]
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn decompose_inverts_the_invariant_matrix() {
+        let inv = Invariant::from_numbers(&[0.5, 2.0, 3.0, 0.3, -0.4, 1.1]).unwrap();
+        let a = inv.a_matrix::<f64>().map(|r| r.to_f64());
+        let d = decompose(&a);
+        for (x, y) in d.iter().zip([0.5, 2.0, 3.0, 0.3, -0.4, 1.1]) {
+            assert!((x - y).abs() < 1e-12, "{d:?}");
+        }
+    }
+}

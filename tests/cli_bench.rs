@@ -1,0 +1,46 @@
+//! `liemesh bench --tiny --json` prints the expected keys with positive numbers.
+
+use std::process::Command;
+
+#[test]
+fn bench_json_has_keys_and_positive_numbers() {
+    let out = Command::new(env!("CARGO_BIN_EXE_liemesh"))
+        .args(["bench", "--quick", "--tiny", "--json"])
+        .output()
+        .expect("runs");
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).expect("JSON");
+    let rows = v["rows"].as_array().expect("rows");
+    let names: Vec<&str> = rows
+        .iter()
+        .map(|r| r["workload"].as_str().unwrap())
+        .collect();
+    for name in ["fig1", "fig6"] {
+        assert!(names.contains(&name), "{names:?}");
+    }
+    assert!(names.iter().any(|n| n.starts_with("sphere-")));
+    assert!(names.iter().any(|n| n.starts_with("ellipsoid-")));
+    for r in rows {
+        assert!(r["triangles"].as_u64().unwrap() > 0);
+        for key in [
+            "sample_ns_per_tri",
+            "triangulate_ns_per_tri",
+            "total_ns_per_tri",
+            "spade_ns_per_tri",
+            "total_over_spade",
+        ] {
+            let x = r[key].as_f64().unwrap_or(-1.0);
+            assert!(x > 0.0 && x.is_finite(), "{key} = {x} in {r}");
+        }
+    }
+    let fig6 = v["fig6_sampling_ms"].as_array().expect("fig6_sampling_ms");
+    assert!(fig6.len() >= 3);
+    for key in ["dual_over_f64", "sphere_scaling", "ellipsoid_scaling"] {
+        let x = v["ratios"][key].as_f64().unwrap_or(-1.0);
+        assert!(x > 0.0 && x.is_finite(), "{key} = {x}");
+    }
+}

@@ -1,0 +1,109 @@
+//! The quality bar of the default mode, measured (issue: mesh quality you can measure).
+
+use liemesh::io::invariant_file::InvariantFile;
+use liemesh::model::{Invariant, LieField};
+use liemesh::preset::Preset;
+use liemesh::quality::{recover, QualityReport};
+use liemesh::{MeshParams, Mode};
+use std::path::Path;
+
+fn measure(invariant: &Invariant, params: &MeshParams) -> (usize, QualityReport) {
+    let run = liemesh::run(&LieField::<f64>::new(invariant), params).unwrap();
+    let q = QualityReport::measure(invariant, params, &run.samples, &run.mesh);
+    (run.mesh.triangles.len(), q)
+}
+
+fn ellipsoid() -> (Invariant, MeshParams) {
+    let file = InvariantFile::read(Path::new("examples/ellipsoid.toml")).unwrap();
+    let mut params = MeshParams::default();
+    file.patch.apply(&mut params).unwrap();
+    (file.invariant, params)
+}
+
+#[test]
+fn fig3_default_mode_is_closed_drift_free_and_well_shaped() {
+    let params = Preset::Fig3.params();
+    let (_, q) = measure(&Preset::Fig3.invariant(), &params);
+    assert!(q.topology.closed && q.topology.euler_characteristic == 2);
+    assert!(q.drift.unwrap().max <= 1e-9, "{:?}", q.drift);
+    assert!(q.shape.min_angle >= 20.0, "{}", q.shape.min_angle);
+    assert!(q.shape.min_angle_p1 >= 30.0, "{}", q.shape.min_angle_p1);
+    assert!(q.face_normal_error_max <= params.beta_max.to_degrees());
+}
+
+#[test]
+fn the_ellipsoid_at_ten_thousand_triangles_is_closed_drift_free_and_well_shaped() {
+    let (inv, params) = ellipsoid();
+    let (triangles, q) = measure(&inv, &params);
+    assert!((8_000..=12_000).contains(&triangles), "{triangles}");
+    assert!(
+        q.topology.closed && q.topology.euler_characteristic == 2,
+        "{:?}",
+        q.topology
+    );
+    assert!(q.drift.unwrap().max <= 1e-9, "{:?}", q.drift);
+    assert!(q.shape.min_angle >= 20.0, "{}", q.shape.min_angle);
+    assert!(q.face_normal_error_max <= params.beta_max.to_degrees());
+}
+
+#[test]
+fn paper_mode_drifts_off_the_sphere_and_the_default_mode_does_not() {
+    let default = Preset::Fig3.params();
+    let paper = MeshParams {
+        mode: Mode::Paper,
+        ..default.clone()
+    };
+    let inv = Preset::Fig3.invariant();
+    let (_, qd) = measure(&inv, &default);
+    let (_, qp) = measure(&inv, &paper);
+    assert!(
+        qp.drift.unwrap().max > 1e-3,
+        "explicit Euler should drift: {:?}",
+        qp.drift
+    );
+    assert!(qd.drift.unwrap().max < 1e-12);
+}
+
+#[test]
+fn the_sphere_is_recovered_from_fig3_to_rounding() {
+    let run = liemesh::run(
+        &LieField::<f64>::new(&Preset::Fig3.invariant()),
+        &Preset::Fig3.params(),
+    )
+    .unwrap();
+    let r = recover(&run.mesh, false, Some(&Preset::Fig3.invariant()));
+    // Max's vertex-normal weights are exact for points on a sphere.
+    assert!(r.relative_error.unwrap() <= 1e-12, "{:?}", r.relative_error);
+    assert!((r.a_invariant[0] - 1.0).abs() < 1e-12);
+}
+
+#[test]
+fn ellipsoid_recovery_error_shrinks_as_the_step_squared() {
+    let (inv, params) = ellipsoid();
+    let error = |scale: f64| {
+        let p = MeshParams {
+            beta_min: params.beta_min * scale,
+            beta_max: params.beta_max * scale,
+            ..params.clone()
+        };
+        let run = liemesh::run(&LieField::<f64>::new(&inv), &p).unwrap();
+        recover(&run.mesh, false, Some(&inv))
+            .relative_error
+            .unwrap()
+    };
+    // Halving the β band halves every step.
+    let (coarse, fine) = (error(1.0), error(0.5));
+    assert!(coarse / fine >= 3.0, "coarse {coarse:e}, fine {fine:e}");
+    assert!(fine <= 1e-3, "fine {fine:e}");
+}
+
+#[test]
+fn fig6_reports_the_recovery_error_beside_the_integrability_defect() {
+    let (_, q) = measure(&Preset::Fig6.invariant(), &Preset::Fig6.params());
+    assert!(
+        q.integrability_defect_max > 0.1,
+        "fig6's field is not integrable"
+    );
+    assert!(q.recovery.relative_error.is_some());
+    assert!(q.drift.is_none(), "no potential, no drift");
+}
