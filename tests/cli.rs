@@ -131,3 +131,18 @@ fn an_invariant_file_meshes_an_ellipsoid_in_every_format() {
         assert!(std::fs::metadata(&out).unwrap().len() > 100);
     }
 }
+
+#[test]
+fn json_prints_the_report_with_its_quality_section() {
+    let o = liemesh()
+        .args(["mesh", "--preset", "fig3", "--json"])
+        .output()
+        .unwrap();
+    assert!(o.status.success());
+    let r: serde_json::Value = serde_json::from_slice(&o.stdout).expect("stdout is JSON");
+    assert_eq!(r["closed"], true);
+    let q = &r["quality"];
+    for key in ["shape", "steps", "face_normal_error_max", "drift", "recovery", "topology"] {
+        assert!(q.get(key).is_some(), "quality lacks {key}");
+    }
+}

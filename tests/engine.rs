@@ -220,3 +220,31 @@ fn fig3_in_f64_agrees_with_mpfr256_within_1e_minus_9() {
         "mesh vertices, f64 vs Mpfr<256>: {vertices:e}"
     );
 }
+
+#[test]
+fn meshes_have_no_unreferenced_or_duplicate_vertices_nor_degenerate_faces() {
+    for p in Preset::ALL {
+        let m = preset_run::<f64>(p).mesh;
+        let mut used = vec![false; m.vertices.len()];
+        for t in &m.triangles {
+            for &i in t {
+                used[i as usize] = true;
+            }
+            let [a, b, c] = t.map(|i| m.vertices[i as usize]);
+            let u = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
+            let w = [c[0] - a[0], c[1] - a[1], c[2] - a[2]];
+            let n = [
+                u[1] * w[2] - u[2] * w[1],
+                u[2] * w[0] - u[0] * w[2],
+                u[0] * w[1] - u[1] * w[0],
+            ];
+            assert!(n.iter().map(|x| x * x).sum::<f64>() > 1e-24, "{p}: degenerate {t:?}");
+        }
+        assert!(used.iter().all(|&u| u), "{p}: unreferenced vertex");
+        let mut keys: Vec<[u64; 3]> = m.vertices.iter().map(|v| v.map(f64::to_bits)).collect();
+        keys.sort_unstable();
+        let n = keys.len();
+        keys.dedup();
+        assert_eq!(keys.len(), n, "{p}: duplicate vertices");
+    }
+}

@@ -43,6 +43,9 @@ pub struct MeshArgs {
     /// Print nothing on success.
     #[arg(short, long)]
     pub quiet: bool,
+    /// Print the report as JSON on standard output instead of the summary.
+    #[arg(long)]
+    pub json: bool,
     /// Parameter overrides (they win over the preset and the file).
     #[command(flatten)]
     pub overrides: Overrides,
@@ -205,6 +208,7 @@ impl MeshArgs {
                 size: 800,
             },
             quiet: false,
+            json: false,
             overrides: Overrides::default(),
         }
     }
@@ -307,7 +311,15 @@ pub(super) fn run(args: &MeshArgs) -> Result<ExitCode, CliError> {
         io::MeshFormat::from_path(out)?;
     }
     let scalar = ScalarKind::from(args.scalar);
-    let outcome = mesh_invariant(&invariant, &params, scalar, args.report.is_some())?;
+    let label = preset.map_or("invariant", |p| p.name());
+    let outcome = with_spinner(&format!("meshing {label} in {scalar}"), args.quiet, || {
+        mesh_invariant(
+            &invariant,
+            &params,
+            scalar,
+            args.report.is_some() || args.json,
+        )
+    })?;
     if let Some(out) = &args.output {
         io::write_mesh(
             &outcome.mesh,
@@ -333,10 +345,41 @@ pub(super) fn run(args: &MeshArgs) -> Result<ExitCode, CliError> {
     if let Some(path) = &args.report {
         write_json(path, &report)?;
     }
-    if !args.quiet {
+    if args.json {
+        println!(
+            "{}",
+            serde_json::to_string_pretty(&report).expect("reports serialise")
+        );
+    } else if !args.quiet {
         print_summary(&report, args.output.as_deref(), args.report.as_deref());
     }
     Ok(ExitCode::SUCCESS)
+}
+
+/// Runs `work`; if it takes longer than a second and standard error is a terminal, shows a
+/// spinner with `message` until it is done (nothing at all when not a terminal or `quiet`).
+pub(super) fn with_spinner<R>(message: &str, quiet: bool, work: impl FnOnce() -> R) -> R {
+    use std::io::IsTerminal;
+    use std::sync::mpsc;
+    use std::time::Duration;
+    if quiet || !std::io::stderr().is_terminal() {
+        return work();
+    }
+    let (done, finished) = mpsc::channel::<()>();
+    let message = message.to_string();
+    let spinner = std::thread::spawn(move || {
+        if finished.recv_timeout(Duration::from_secs(1)).is_ok() {
+            return;
+        }
+        let bar = indicatif::ProgressBar::new_spinner().with_message(message);
+        bar.enable_steady_tick(Duration::from_millis(100));
+        let _ = finished.recv();
+        bar.finish_and_clear();
+    });
+    let result = work();
+    let _ = done.send(());
+    let _ = spinner.join();
+    result
 }
 
 pub(super) fn write_json<S: serde::Serialize>(path: &Path, value: &S) -> Result<(), CliError> {
