@@ -28,6 +28,8 @@
 pub mod audit;
 pub mod cli;
 mod error;
+#[doc(hidden)]
+pub mod fuzz_checks;
 pub mod io;
 pub mod model;
 mod params;

@@ -231,10 +231,20 @@ impl MeshParams {
                 return Err(MeshError::ZeroBudget(name));
             }
         }
-        if let Method::Previous { curves } = self.method {
-            if curves < 3 {
-                return Err(MeshError::TooFewCurves(curves));
+        let fan = match self.method {
+            Method::Previous { curves } if curves < 3 => {
+                return Err(MeshError::TooFewCurves(curves))
             }
+            Method::Previous { curves } => curves,
+            Method::Proposed => 6,
+        };
+        if b.max_curves < fan {
+            return Err(MeshError::OutOfRange {
+                name: "max_curves",
+                value: b.max_curves as f64,
+                why: "the curve budget must allow the initial fan (6 curves for the proposed \
+                      method, `curves` for the previous one)",
+            });
         }
         Ok(())
     }

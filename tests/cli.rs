@@ -142,7 +142,14 @@ fn json_prints_the_report_with_its_quality_section() {
     let r: serde_json::Value = serde_json::from_slice(&o.stdout).expect("stdout is JSON");
     assert_eq!(r["closed"], true);
     let q = &r["quality"];
-    for key in ["shape", "steps", "face_normal_error_max", "drift", "recovery", "topology"] {
+    for key in [
+        "shape",
+        "steps",
+        "face_normal_error_max",
+        "drift",
+        "recovery",
+        "topology",
+    ] {
         assert!(q.get(key).is_some(), "quality lacks {key}");
     }
 }

@@ -238,7 +238,10 @@ fn meshes_have_no_unreferenced_or_duplicate_vertices_nor_degenerate_faces() {
                 u[2] * w[0] - u[0] * w[2],
                 u[0] * w[1] - u[1] * w[0],
             ];
-            assert!(n.iter().map(|x| x * x).sum::<f64>() > 1e-24, "{p}: degenerate {t:?}");
+            assert!(
+                n.iter().map(|x| x * x).sum::<f64>() > 1e-24,
+                "{p}: degenerate {t:?}"
+            );
         }
         assert!(used.iter().all(|&u| u), "{p}: unreferenced vertex");
         let mut keys: Vec<[u64; 3]> = m.vertices.iter().map(|v| v.map(f64::to_bits)).collect();

@@ -37,7 +37,8 @@ pub struct WorkloadRow {
     pub points: usize,
     /// Sampling, ns per triangle.
     pub sample_ns_per_tri: f64,
-    /// Triangulation (chart Delaunay, flips, closing, assembly), ns per triangle.
+    /// Triangulation (chart Delaunay, flips, closing, assembly, and in the default mode the
+    /// relaxation with its flips), ns per triangle.
     pub triangulate_ns_per_tri: f64,
     /// Sampling + triangulation, ns per triangle.
     pub total_ns_per_tri: f64,
@@ -46,6 +47,31 @@ pub struct WorkloadRow {
     /// Total ÷ spade-only.
     pub total_over_spade: f64,
 }
+
+/// The fidelity workload: the coarsest mesh whose largest face-normal error is within
+/// [`FIDELITY_LIMIT_DEG`], found by scanning the β band downward.
+#[derive(Debug, Clone, Serialize)]
+pub struct FidelityRow {
+    /// `sphere` or `ellipsoid`.
+    pub workload: String,
+    /// The β band found, degrees.
+    pub beta_deg: [f64; 2],
+    /// Triangles of that mesh.
+    pub triangles: usize,
+    /// Its largest face-normal error, degrees.
+    pub max_error_deg: f64,
+    /// Whether the error limit was reached (otherwise the row is the lowest error seen).
+    pub reached: bool,
+    /// End-to-end time of that mesh (`liemesh::run`), milliseconds (median of repeats).
+    pub ms: f64,
+}
+
+/// The face-normal error the fidelity workload must reach (degrees): what grid-based implicit
+/// meshers show at about 10^5 sphere triangles.
+pub const FIDELITY_LIMIT_DEG: f64 = 0.7;
+
+/// The fidelity scan stops beyond this many triangles.
+pub const FIDELITY_MAX_TRIANGLES: usize = 400_000;
 
 /// The ratios issue 6 asks for.
 #[derive(Debug, Clone, Serialize)]
@@ -67,6 +93,8 @@ pub struct BenchReport {
     pub rows: Vec<WorkloadRow>,
     /// fig6 sampling times in ms per scalar type.
     pub fig6_sampling_ms: Vec<(String, f64)>,
+    /// The fidelity workload (sphere, ellipsoid).
+    pub fidelity: Vec<FidelityRow>,
     /// The ratios.
     pub ratios: Ratios,
 }
@@ -115,7 +143,14 @@ fn time_workload(
         let t0 = Instant::now();
         let samples = crate::sample::sample(&field, params)?;
         let t1 = Instant::now();
-        let (mesh, _) = crate::triangulate::triangulate(&samples, params.terminal.close, improve)?;
+        let (mut mesh, _) =
+            crate::triangulate::triangulate(&samples, params.terminal.close, improve)?;
+        if improve {
+            // The default mode's relaxation is part of the pipeline (`crate::run`).
+            std::hint::black_box(crate::triangulate::relax(
+                &field, params, &samples, &mut mesh,
+            ));
+        }
         let t2 = Instant::now();
         let chart: Vec<spade::Point2<f64>> = (0..samples.points.len())
             .map(|i| {
@@ -145,6 +180,58 @@ fn time_workload(
         total_ns_per_tri: s + t,
         spade_ns_per_tri: b,
         total_over_spade: (s + t) / b,
+    })
+}
+
+/// Scans the β band of [`workload_params`] downward (each trial 15 % narrower) until the
+/// largest face-normal error is within [`FIDELITY_LIMIT_DEG`], then times that mesh. The scan
+/// gives up beyond [`FIDELITY_MAX_TRIANGLES`]; the row then holds the lowest error seen and
+/// `reached == false`.
+fn fidelity(ellipsoid: bool, repeats: usize) -> Result<FidelityRow, CliError> {
+    let (inv, base) = workload_params(ellipsoid, if ellipsoid { 9000 } else { 2000 });
+    let field = LieField::<f64>::new(&inv);
+    let band = |scale: f64| {
+        let mut params = base.clone();
+        params.beta_min *= scale;
+        params.beta_max *= scale;
+        params.dt *= scale;
+        params
+    };
+    // Start 4× coarser than the fig3 band.
+    let mut scale = 4.0;
+    let mut best: Option<(f64, f64, usize)> = None;
+    let mut found = None;
+    while scale > 1e-3 {
+        let mesh = crate::generate(&field, &band(scale))?;
+        let (max, _) = crate::quality::face_normal_error(&field, &mesh);
+        if best.is_none_or(|(e, _, _)| max < e) {
+            best = Some((max, scale, mesh.triangles.len()));
+        }
+        if max <= FIDELITY_LIMIT_DEG {
+            found = Some(scale);
+            break;
+        }
+        if mesh.triangles.len() > FIDELITY_MAX_TRIANGLES {
+            break;
+        }
+        scale *= 0.85;
+    }
+    let (max, scale, triangles) = best.expect("at least one trial");
+    let scale = found.unwrap_or(scale);
+    let params = band(scale);
+    let mut times = Vec::new();
+    for _ in 0..repeats {
+        let t0 = Instant::now();
+        std::hint::black_box(crate::generate(&field, &params)?);
+        times.push(t0.elapsed().as_secs_f64() * 1e3);
+    }
+    Ok(FidelityRow {
+        workload: if ellipsoid { "ellipsoid" } else { "sphere" }.to_string(),
+        beta_deg: [params.beta_min.to_degrees(), params.beta_max.to_degrees()],
+        triangles,
+        max_error_deg: max,
+        reached: found.is_some(),
+        ms: median(times),
     })
 }
 
@@ -239,9 +326,11 @@ pub fn measure(args: &BenchArgs) -> Result<BenchReport, CliError> {
         sphere_scaling: scaling[0],
         ellipsoid_scaling: scaling[1],
     };
+    let fidelity = vec![fidelity(false, rep)?, fidelity(true, rep)?];
     Ok(BenchReport {
         rows,
         fig6_sampling_ms: fig6,
+        fidelity,
         ratios,
     })
 }
@@ -280,6 +369,27 @@ pub fn run(args: &BenchArgs) -> Result<ExitCode, CliError> {
     println!();
     for (name, ms) in &report.fig6_sampling_ms {
         println!("fig6 sampling {name:<8} {ms:>10.3} ms");
+    }
+    println!();
+    println!(
+        "{:<14} {:>9} {:>16} {:>12} {:>10}  (target: max err <= {FIDELITY_LIMIT_DEG}°)",
+        "fidelity", "triangles", "beta band (deg)", "max err (°)", "ms"
+    );
+    for f in &report.fidelity {
+        println!(
+            "{:<14} {:>9} {:>7.3}–{:<8.3} {:>12.3} {:>10.3}{}",
+            f.workload,
+            f.triangles,
+            f.beta_deg[0],
+            f.beta_deg[1],
+            f.max_error_deg,
+            f.ms,
+            if f.reached {
+                ""
+            } else {
+                "  NOT REACHED (lowest error seen)"
+            }
+        );
     }
     let r = &report.ratios;
     println!();

@@ -4,6 +4,7 @@
 //! (the message on standard error says what was wrong and what to do).
 
 mod audit;
+mod batch;
 mod bench;
 mod mesh;
 mod paper;
@@ -44,6 +45,8 @@ pub enum Command {
     Paper(paper::PaperArgs),
     /// Time the performance workloads (issue 6) and print a table or JSON.
     Bench(bench::BenchArgs),
+    /// Mesh every invariant file of a folder (or list) in parallel: one mesh + report each.
+    Batch(batch::BatchArgs),
 }
 
 /// Any error the command line reports (exit code 2).
@@ -95,6 +98,7 @@ pub fn run(cli: Cli) -> Result<ExitCode, CliError> {
         Some(Command::Quality(args)) => quality::run(&args),
         Some(Command::Recover(args)) => quality::recover_cmd(&args),
         Some(Command::Bench(args)) => bench::run(&args),
+        Some(Command::Batch(args)) => batch::run(&args),
         Some(Command::Paper(args)) => paper::run(&args),
         None => mesh::run(&MeshArgs::default_job()),
     }

@@ -4,6 +4,9 @@ use crate::triangulate::Mesh;
 use serde::{Deserialize, Serialize};
 use std::collections::HashMap;
 
+/// A fast hasher for edge keys (the counts do not depend on iteration order).
+type EdgeHash = std::hash::BuildHasherDefault<crate::triangulate::EdgeHasher>;
+
 /// Topological facts about a mesh.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 pub struct Topology {
@@ -33,7 +36,8 @@ impl Topology {
     /// Computes the topology of `mesh`.
     pub fn of(mesh: &Mesh) -> Topology {
         // (min, max) → (uses, uses in the min→max direction)
-        let mut edges: HashMap<(u32, u32), (u32, u32)> = HashMap::new();
+        let mut edges: HashMap<(u32, u32), (u32, u32), EdgeHash> =
+            HashMap::with_capacity_and_hasher(3 * mesh.triangles.len() / 2, EdgeHash::default());
         let mut degenerate = 0;
         let mut used = vec![false; mesh.vertices.len()];
         for t in &mesh.triangles {

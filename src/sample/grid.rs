@@ -57,8 +57,20 @@ impl Grid {
 
     /// Calls `f` for every stored index whose cell meets the ball of `radius` around `p`
     /// (a superset of the points within `radius`), in a deterministic order.
+    ///
+    /// When the cube of cells around `p` has more cells than the grid has buckets (a radius of
+    /// many cells: an initial Δt far below the step lengths), every bucket is visited
+    /// instead, which is cheaper and still a superset.
     pub(crate) fn for_each_near(&self, p: [f64; 3], radius: f64, mut f: impl FnMut(u32)) {
-        let r = (radius / self.cell).ceil().clamp(0.0, 64.0) as i32;
+        let r = (radius / self.cell).ceil().max(0.0);
+        let cube = (2.0 * r + 1.0).powi(3);
+        if cube.is_nan() || cube > self.buckets.len() as f64 {
+            for &i in self.buckets.values().flatten() {
+                f(i);
+            }
+            return;
+        }
+        let r = r as i32;
         let (cx, cy, cz) = self.key(p);
         for dx in -r..=r {
             for dy in -r..=r {

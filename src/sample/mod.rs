@@ -177,6 +177,7 @@ pub fn sample<T: Scalar, F: NormalField<T>>(
             hit_point_budget: false,
         },
         pos: vec![params.p0],
+        chart: vec![[0.0, 0.0]],
         live: Vec::new(),
         heap: BinaryHeap::new(),
         grid: Grid::new(params.dt.max(1e-300)),
@@ -226,6 +227,9 @@ struct Sampler<'a, T, F> {
     out: Samples<T>,
     /// `f64` copies of the points for the geometric tests.
     pos: Vec<[f64; 3]>,
+    /// Chart positions of the points (as [`Samples::chart`] computes them), cached so that
+    /// the closure test does no trigonometry per neighbour.
+    chart: Vec<[f64; 2]>,
     live: Vec<Live<T>>,
     heap: BinaryHeap<Reverse<(u64, u32)>>,
     grid: Grid,
@@ -340,6 +344,7 @@ impl<T: Scalar, F: NormalField<T>> Sampler<'_, T, F> {
         });
         self.out.curves[ci].points.push(index);
         self.pos.push(q);
+        self.chart.push(self.out.chart(index as usize));
         self.grid.insert(q, index);
         let live = &mut self.live[ci];
         live.p = step.point;
@@ -386,7 +391,7 @@ impl<T: Scalar, F: NormalField<T>> Sampler<'_, T, F> {
             }
             let d = dist(q, self.pos[j as usize]);
             if d < radius {
-                let cj = self.out.chart(j as usize);
+                let cj = self.chart[j as usize];
                 let dc = ((cj[0] - chart_q[0]).powi(2) + (cj[1] - chart_q[1]).powi(2)).sqrt();
                 if dc > 2.0 * d + len {
                     hit = true;
@@ -512,6 +517,7 @@ impl<T: Scalar, F: NormalField<T>> Sampler<'_, T, F> {
             end: CurveEnd::Budget,
         });
         self.pos.push(start_f);
+        self.chart.push(self.out.chart(index as usize));
         self.grid.insert(start_f, index);
         let (left, right) = if k_is_right { (c, k) } else { (k, c) };
         self.live.push(Live {

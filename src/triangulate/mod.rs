@@ -16,6 +16,7 @@ mod flip;
 mod mesh;
 mod relax;
 
+pub(crate) use flip::EdgeHasher;
 pub(crate) use relax::relax;
 
 pub use mesh::{Mesh, Provenance};
@@ -79,7 +80,11 @@ pub fn triangulate<T: Scalar>(
             .iter()
             .map(|&i| samples.normals[i as usize].to_f64())
             .collect();
-        closing = close_hole(&front, &pos, &normals);
+        closing = close_hole(&front, &pos, &normals, &triangles);
+        if !stitches_cleanly(&triangles, &closing) {
+            // Better an honest hole than a non-manifold mesh.
+            closing.clear();
+        }
     }
 
     let mut all = triangles.clone();
@@ -231,7 +236,12 @@ fn chart_triangles(chart: &[[f64; 2]], front: &[u32]) -> Result<Vec<[u32; 3]>, M
             }
         }
     }
-    let inside = |c: [f64; 2]| !use_front || inside_star(chart, front, c);
+    let (a0, rel) = if use_front {
+        star_angles(chart, front)
+    } else {
+        (0.0, Vec::new())
+    };
+    let inside = |c: [f64; 2]| !use_front || inside_star(chart, front, (a0, &rel), c);
     let mut triangles = Vec::with_capacity(2 * chart.len());
     for face in cdt.inner_faces() {
         let [a, b, c] = face.vertices();
@@ -261,18 +271,36 @@ fn star_shaped(chart: &[[f64; 2]], front: &[u32]) -> bool {
     (total - std::f64::consts::TAU).abs() < 1e-6
 }
 
-fn inside_star(chart: &[[f64; 2]], front: &[u32], c: [f64; 2]) -> bool {
+/// Polar angle of `p` in `[0, 2π)`.
+fn polar_angle(p: [f64; 2]) -> f64 {
+    p[1].atan2(p[0]).rem_euclid(std::f64::consts::TAU)
+}
+
+/// Polar angle of `p` relative to `a0`, in `[0, 2π)`.
+fn rel_angle(a0: f64, p: [f64; 2]) -> f64 {
+    (polar_angle(p) - a0).rem_euclid(std::f64::consts::TAU)
+}
+
+/// `a0` (the first front vertex's polar angle) and every front vertex's angle relative to
+/// it, computed once for all the `inside_star` tests.
+fn star_angles(chart: &[[f64; 2]], front: &[u32]) -> (f64, Vec<f64>) {
+    let a0 = polar_angle(chart[front[0] as usize]);
+    let rel = front
+        .iter()
+        .map(|&v| rel_angle(a0, chart[v as usize]))
+        .collect();
+    (a0, rel)
+}
+
+fn inside_star(chart: &[[f64; 2]], front: &[u32], (a0, rel): (f64, &[f64]), c: [f64; 2]) -> bool {
     // Wedge containing the direction of c, by binary search on the vertex angles.
-    let angle = |p: [f64; 2]| p[1].atan2(p[0]).rem_euclid(std::f64::consts::TAU);
-    let a0 = angle(chart[front[0] as usize]);
-    let rel = |p: [f64; 2]| (angle(p) - a0).rem_euclid(std::f64::consts::TAU);
-    let target = rel(c);
+    let target = rel_angle(a0, c);
     let m = front.len();
     // Vertex angles relative to the first are increasing (star-shaped, counter-clockwise).
     let (mut lo, mut hi) = (0usize, m);
     while hi - lo > 1 {
         let mid = (lo + hi) / 2;
-        if rel(chart[front[mid] as usize]) <= target {
+        if rel[mid] <= target {
             lo = mid;
         } else {
             hi = mid;
@@ -285,7 +313,12 @@ fn inside_star(chart: &[[f64; 2]], front: &[u32], c: [f64; 2]) -> bool {
 
 /// Chart 2: triangulates the hole bounded by the front polygon in the plane across the mean
 /// normal of its vertices. Returns no triangles when the projected polygon is not simple.
-fn close_hole(front: &[u32], pos: &[[f64; 3]], normals: &[[f64; 3]]) -> Vec<[u32; 3]> {
+fn close_hole(
+    front: &[u32],
+    pos: &[[f64; 3]],
+    normals: &[[f64; 3]],
+    existing: &[[u32; 3]],
+) -> Vec<[u32; 3]> {
     let m = front.len();
     let mut mean = [0.0; 3];
     for n in normals {
@@ -313,8 +346,11 @@ fn close_hole(front: &[u32], pos: &[[f64; 3]], normals: &[[f64; 3]]) -> Vec<[u32
             [dot3(p, f1), dot3(p, f2)]
         })
         .collect();
-    if !simple_polygon(&proj) {
-        return clip_ears(front, pos, normals);
+    // Chart 1 lies to the left of the front, so seen from outside the hole the front runs
+    // clockwise; when its projection does not (a curve overshot the hole), triangles that are
+    // counter-clockwise in the projection would disagree with chart 1's orientation.
+    if !simple_polygon(&proj) || signed_area(&proj) >= 0.0 {
+        return clip_ears(front, pos, normals, existing);
     }
     let vertices: Vec<ChartVertex> = proj
         .iter()
@@ -334,7 +370,7 @@ fn close_hole(front: &[u32], pos: &[[f64; 3]], normals: &[[f64; 3]]) -> Vec<[u32
         return Vec::new();
     };
     if conflict || cdt.num_vertices() != m {
-        return clip_ears(front, pos, normals);
+        return clip_ears(front, pos, normals, existing);
     }
     let mut out = Vec::new();
     for face in cdt.inner_faces() {
@@ -349,21 +385,68 @@ fn close_hole(front: &[u32], pos: &[[f64; 3]], normals: &[[f64; 3]]) -> Vec<[u32
             ]);
         }
     }
+    // A diagonal of the hole that chart 1 already has as an edge would make the mesh
+    // non-manifold: cut ears instead, which never repeat an edge.
+    let mut have: std::collections::HashSet<(u32, u32)> = existing
+        .iter()
+        .flat_map(|t| (0..3).map(move |k| (t[k], t[(k + 1) % 3])))
+        .collect();
+    for t in &out {
+        for k in 0..3 {
+            let (a, b) = (t[k], t[(k + 1) % 3]);
+            // The hole's triangles use each loop edge in the opposite direction to chart 1,
+            // and any other edge must be new.
+            if have.contains(&(a, b)) || !have.insert((a, b)) {
+                return clip_ears(front, pos, normals, existing);
+            }
+        }
+    }
     out
+}
+
+/// Whether any of `triangles` faces against the field normal at its corners (a closing
+/// triangle across a thin, twisted hole can).
+fn folds(triangles: &[[u32; 3]], pos: &[[f64; 3]], normals: &[[f64; 3]]) -> bool {
+    triangles.iter().any(|t| {
+        let [a, b, c] = t.map(|i| pos[i as usize]);
+        let face = cross3(sub3(b, a), sub3(c, a));
+        let mut g = [0.0; 3];
+        for &i in t {
+            for k in 0..3 {
+                g[k] += normals[i as usize][k];
+            }
+        }
+        dot3(face, g) <= 0.0
+    })
+}
+
+/// Whether `closing` meets `chart` edge to edge: every directed edge is used once, and every
+/// edge of the union by at most two triangles in opposite directions.
+fn stitches_cleanly(chart: &[[u32; 3]], closing: &[[u32; 3]]) -> bool {
+    let mut directed = std::collections::HashSet::with_capacity(3 * (chart.len() + closing.len()));
+    chart
+        .iter()
+        .chain(closing)
+        .all(|t| (0..3).all(|k| t[k] != t[(k + 1) % 3] && directed.insert((t[k], t[(k + 1) % 3]))))
 }
 
 /// Closes a hole whose projection is not a simple polygon (e.g. the thin band an ellipsoid's
 /// curves leave along a caustic): repeatedly cuts off the ear with the smallest angle inside
 /// the hole, measured in space about the field normal, never creating an edge twice.
-fn clip_ears(front: &[u32], pos: &[[f64; 3]], normals: &[[f64; 3]]) -> Vec<[u32; 3]> {
+fn clip_ears(
+    front: &[u32],
+    pos: &[[f64; 3]],
+    normals: &[[f64; 3]],
+    existing: &[[u32; 3]],
+) -> Vec<[u32; 3]> {
     // (sample index, normal) around the loop; the hole lies to the right of the loop.
     let mut ring: Vec<(u32, [f64; 3])> =
         front.iter().copied().zip(normals.iter().copied()).collect();
-    let mut edges: std::collections::HashSet<(u32, u32)> = (0..ring.len())
-        .map(|i| {
-            let (a, b) = (ring[i].0, ring[(i + 1) % ring.len()].0);
-            (a.min(b), a.max(b))
-        })
+    // Every edge the mesh already has: an ear must not repeat one (that would make it
+    // non-manifold).
+    let mut edges: std::collections::HashSet<(u32, u32)> = existing
+        .iter()
+        .flat_map(|t| (0..3).map(move |k| (t[k].min(t[(k + 1) % 3]), t[k].max(t[(k + 1) % 3]))))
         .collect();
     let mut out = Vec::with_capacity(ring.len());
     while ring.len() > 3 {
@@ -392,6 +475,14 @@ fn clip_ears(front: &[u32], pos: &[[f64; 3]], normals: &[[f64; 3]]) -> Vec<[u32;
         ring.remove(i);
     }
     out.push([ring[2].0, ring[1].0, ring[0].0]);
+    // Ears across a thin, twisted band can face against the field: then leave the hole open.
+    let mut normal_of = vec![[0.0; 3]; pos.len()];
+    for (&v, n) in front.iter().zip(normals) {
+        normal_of[v as usize] = *n;
+    }
+    if folds(&out, pos, &normal_of) {
+        return Vec::new();
+    }
     out
 }
 
@@ -412,6 +503,12 @@ fn dot3(a: [f64; 3], b: [f64; 3]) -> f64 {
 fn normalize3(a: [f64; 3]) -> [f64; 3] {
     let l = dot3(a, a).sqrt();
     [a[0] / l, a[1] / l, a[2] / l]
+}
+
+/// Twice the signed area of the closed polygon: positive when it runs counter-clockwise.
+fn signed_area(p: &[[f64; 2]]) -> f64 {
+    let m = p.len();
+    (0..m).map(|i| cross2(p[i], p[(i + 1) % m])).sum()
 }
 
 /// No two non-adjacent edges of the closed polygon meet (O(m²): the hole is small).

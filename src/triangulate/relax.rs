@@ -37,45 +37,76 @@ pub(crate) fn relax<T: Scalar, F: NormalField<T>>(
             samples.points[i].clone()
         })
         .collect();
-    // Neighbours, sorted for a deterministic sum; boundary vertices are fixed.
-    let mut neighbours: Vec<Vec<u32>> = vec![Vec::new(); n];
-    let mut edge_uses = std::collections::HashMap::new();
+    // Neighbours in CSR form (`adj[start[v]..start[v] + len[v]]`), sorted and deduplicated
+    // for a deterministic sum; boundary vertices are fixed.
+    let mut start = vec![0u32; n + 1];
+    for t in &mesh.triangles {
+        for &a in t {
+            start[a as usize + 1] += 1;
+        }
+    }
+    for v in 0..n {
+        start[v + 1] += start[v];
+    }
+    let mut fill: Vec<u32> = start[..n].to_vec();
+    let mut adj = vec![0u32; start[n] as usize];
+    // Undirected edges, one entry per use: an edge not used exactly twice is a boundary.
+    let mut edges: Vec<u64> = Vec::with_capacity(3 * mesh.triangles.len());
     for t in &mesh.triangles {
         for k in 0..3 {
             let (a, b) = (t[k], t[(k + 1) % 3]);
-            neighbours[a as usize].push(b);
-            *edge_uses.entry((a.min(b), a.max(b))).or_insert(0u32) += 1;
+            adj[fill[a as usize] as usize] = b;
+            fill[a as usize] += 1;
+            edges.push(((a.min(b) as u64) << 32) | a.max(b) as u64);
         }
     }
+    edges.sort_unstable();
     let mut fixed = vec![false; n];
-    for (&(a, b), &uses) in &edge_uses {
-        if uses != 2 {
-            fixed[a as usize] = true;
-            fixed[b as usize] = true;
+    let mut i = 0;
+    while i < edges.len() {
+        let mut j = i + 1;
+        while j < edges.len() && edges[j] == edges[i] {
+            j += 1;
         }
+        if j - i != 2 {
+            fixed[(edges[i] >> 32) as usize] = true;
+            fixed[(edges[i] & 0xffff_ffff) as usize] = true;
+        }
+        i = j;
     }
     for (v, pr) in mesh.provenance.iter().enumerate() {
         if pr.curve == 0 && pr.step == 0 {
             fixed[v] = true;
         }
     }
-    for list in &mut neighbours {
+    let mut len = vec![0u32; n];
+    for v in 0..n {
+        let list = &mut adj[start[v] as usize..start[v + 1] as usize];
         list.sort_unstable();
-        list.dedup();
+        let mut m = 0;
+        for k in 0..list.len() {
+            if k == 0 || list[k] != list[m - 1] {
+                list[m] = list[k];
+                m += 1;
+            }
+        }
+        len[v] = m as u32;
     }
+    let neighbours = |v: usize| &adj[start[v] as usize..(start[v] + len[v]) as usize];
     let cfg = StepConfig::<T>::new(params);
     let damping = T::from_f64(DAMPING);
     for _ in 0..SWEEPS {
         let moved: Vec<Vec3<T>> = (0..n)
             .map(|v| {
-                if fixed[v] || neighbours[v].is_empty() {
+                let nb = neighbours(v);
+                if fixed[v] || nb.is_empty() {
                     return pos[v].clone();
                 }
                 let mut c = Vec3::<T>::zero();
-                for &u in &neighbours[v] {
+                for &u in nb {
                     c = &c + &pos[u as usize];
                 }
-                let c = c.scale(&(T::one() / T::from_f64(neighbours[v].len() as f64)));
+                let c = c.scale(&(T::one() / T::from_f64(nb.len() as f64)));
                 let d = &c - &pos[v];
                 let len = d.norm() * damping.clone();
                 if len.partial_cmp(&T::zero()) != Some(std::cmp::Ordering::Greater) {
@@ -84,7 +115,7 @@ pub(crate) fn relax<T: Scalar, F: NormalField<T>>(
                 trace::step_fixed(field, &cfg, &pos[v], &d, &len).unwrap_or_else(|_| pos[v].clone())
             })
             .collect();
-        pos = moved;
+        pos = keep_orientation(&mesh.triangles, &mesh.normals, pos, moved);
     }
     mesh.vertices = pos.iter().map(|p| p.to_f64()).collect();
     mesh.normals = pos
@@ -98,4 +129,66 @@ pub(crate) fn relax<T: Scalar, F: NormalField<T>>(
     let budget = 8 * mesh.triangles.len() + 64;
     flip_to_surface_delaunay(&mesh.vertices, &mesh.normals, &mut mesh.triangles, budget);
     pos
+}
+
+/// Cosine between a face and the field normal below which a move counts as folding it.
+const MIN_AGREEMENT: f64 = 0.5;
+
+/// Accepts the sweep's moves except where a triangle would fold: the vertices of every
+/// triangle whose face normal turns away from the field normal (and did not before) go back
+/// to where they were, until no such triangle is left.
+fn keep_orientation<T: Scalar>(
+    triangles: &[[u32; 3]],
+    normals: &[[f64; 3]],
+    old: Vec<Vec3<T>>,
+    mut new: Vec<Vec3<T>>,
+) -> Vec<Vec3<T>> {
+    let agreement = |pos: &[[f64; 3]], t: &[u32; 3]| {
+        let [a, b, c] = t.map(|i| pos[i as usize]);
+        let u = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
+        let w = [c[0] - a[0], c[1] - a[1], c[2] - a[2]];
+        let f = [
+            u[1] * w[2] - u[2] * w[1],
+            u[2] * w[0] - u[0] * w[2],
+            u[0] * w[1] - u[1] * w[0],
+        ];
+        let mut g = [0.0; 3];
+        for &i in t {
+            for k in 0..3 {
+                g[k] += normals[i as usize][k];
+            }
+        }
+        let d = ((f[0] * f[0] + f[1] * f[1] + f[2] * f[2])
+            * (g[0] * g[0] + g[1] * g[1] + g[2] * g[2]))
+            .sqrt();
+        if d > 0.0 {
+            (f[0] * g[0] + f[1] * g[1] + f[2] * g[2]) / d
+        } else {
+            -1.0
+        }
+    };
+    let old_f: Vec<[f64; 3]> = old.iter().map(|p| p.to_f64()).collect();
+    let before: Vec<f64> = triangles.iter().map(|t| agreement(&old_f, t)).collect();
+    let mut new_f: Vec<[f64; 3]> = new.iter().map(|p| p.to_f64()).collect();
+    // Each round reverts at least one moved vertex, so this ends within `new.len()` rounds.
+    for _ in 0..=new.len() {
+        let mut reverted = false;
+        for (t, &b) in triangles.iter().zip(&before) {
+            let limit = MIN_AGREEMENT.min(b);
+            if agreement(&new_f, t) < limit {
+                for &i in t {
+                    let i = i as usize;
+                    if new_f[i] != old_f[i] {
+                        new[i] = old[i].clone();
+                        new_f[i] = old_f[i];
+                        reverted = true;
+                    }
+                }
+            }
+        }
+        if !reverted {
+            break;
+        }
+    }
+    new
 }

@@ -1,0 +1,14 @@
+#![no_main]
+//! Invariant + parameters (a `liemesh::fuzz_checks::MesherInput`) → `liemesh::run`;
+//! the run must give a valid mesh or the typed error that fits the input.
+//!
+//! The decoding and the checks are `liemesh::fuzz_checks::mesher`, shared with the corpus replay
+//! in `tests/fuzz_corpus.rs`.
+
+use libfuzzer_sys::fuzz_target;
+
+fuzz_target!(|data: &[u8]| {
+    if let Err(violation) = liemesh::fuzz_checks::mesher(data) {
+        panic!("{violation}");
+    }
+});

@@ -1,0 +1,252 @@
+//! Property tests of the whole mesher over random linear and Hamiltonian invariants, initial
+//! points and parameters near the paper's (DESIGN.md §4).
+//!
+//! Every case runs `liemesh::run` in `f64` and hands the result to
+//! [`liemesh::fuzz_checks::check_run`], the same check the `mesher` fuzz target uses. It holds
+//! when the run returns a typed `MeshError` that fits the input (exactly the validation
+//! error for invalid parameters; a singular `p0`, a direction along the normal or an
+//! untriangulable sample set for valid ones), or a mesh with
+//!
+//! - no NaN, no degenerate (repeated index, zero area) or duplicate triangle, no unused vertex;
+//! - every edge in at most two triangles and consistent orientation ([`Topology`]);
+//! - every accepted step's predicted α inside `[β_min, β_max]` unless the step reports a
+//!   limit (clamp or budget);
+//! - the budgets respected: at most `max_points` points, `max_curves` curves,
+//!   `max_steps_per_curve + 1` points per curve;
+//! - consistent bookkeeping (provenance, arc lengths, radius and bounding box) and a chart
+//!   triangulation that is counter-clockwise and Delaunay off the constraints.
+//!
+//! A panic anywhere fails the case. Cases come from a fixed seed so that the suite is
+//! reproducible; `PROPTEST_RNG_SEED=<n>` explores others and `PROPTEST_CASES=<n>` changes
+//! their number. Each property also asserts that enough of its cases produced a mesh, so that
+//! it cannot pass by rejecting everything.
+//!
+//! [`Topology`]: liemesh::quality::Topology
+
+use liemesh::fuzz_checks::check_run;
+use liemesh::model::{Invariant, LieField};
+use liemesh::preset::{Preset, FIG46_INVARIANT};
+use liemesh::{Budget, MeshParams, Method, Mode};
+use proptest::prelude::*;
+use proptest::test_runner::{Config, RngSeed, TestCaseError, TestRunner};
+use std::cell::Cell;
+use std::f64::consts::PI;
+
+const SEED: u64 = 0x11e_3e54;
+
+/// Runs `cases` cases of `strategy` through the mesher; returns (meshes, errors).
+fn run_cases(
+    cases: u32,
+    strategy: impl Strategy<Value = (Vec<f64>, MeshParams)>,
+) -> (usize, usize) {
+    let mut config = Config {
+        failure_persistence: None,
+        max_shrink_iters: 256,
+        ..Config::default()
+    };
+    if config.rng_seed == RngSeed::Random {
+        config.rng_seed = RngSeed::Fixed(SEED);
+    }
+    if std::env::var_os("PROPTEST_CASES").is_none() {
+        config.cases = cases;
+    }
+    let (ok, err) = (Cell::new(0), Cell::new(0));
+    let mut runner = TestRunner::new(config);
+    let result = runner.run(&strategy, |(numbers, params)| {
+        let invariant = Invariant::from_numbers(&numbers)
+            .map_err(|e| TestCaseError::fail(format!("bad strategy: {e}")))?;
+        let field = LieField::<f64>::new(&invariant);
+        let result = liemesh::run(&field, &params);
+        check_run(&params, &result).map_err(|v| TestCaseError::fail(v.0))?;
+        match result {
+            Ok(_) => ok.set(ok.get() + 1),
+            Err(_) => err.set(err.get() + 1),
+        }
+        Ok(())
+    });
+    if let Err(e) = result {
+        panic!("{e}");
+    }
+    (ok.get(), err.get())
+}
+
+/// A linear invariant: λ's of either sign around the paper's magnitudes, any angles.
+fn linear_invariant() -> impl Strategy<Value = Vec<f64>> {
+    (
+        prop::array::uniform3(prop_oneof![0.2..2.0f64, -2.0..-0.2f64]),
+        prop::array::uniform3(-PI..PI),
+    )
+        .prop_map(|(l, a)| vec![l[0], l[1], l[2], a[0], a[1], a[2]])
+}
+
+/// A Hamiltonian invariant: 12 numbers in the paper's text order or 18 numbers near Table 2.
+fn hamiltonian_invariant() -> impl Strategy<Value = Vec<f64>> {
+    prop_oneof![
+        prop::collection::vec(-1.0..1.0f64, 12),
+        prop::collection::vec(-0.3..0.3f64, 18).prop_map(|d| FIG46_INVARIANT
+            .iter()
+            .zip(d)
+            .map(|(a, b)| a + b)
+            .collect()),
+    ]
+}
+
+/// Parameters near `preset`'s, with small budgets (at most `max_points` points).
+fn params_near(preset: Preset, max_points: usize) -> impl Strategy<Value = MeshParams> {
+    let base = preset.params();
+    let shape = (
+        prop_oneof![
+            Just(Method::Proposed),
+            (3usize..40).prop_map(|curves| Method::Previous { curves })
+        ],
+        prop_oneof![Just(Mode::Default), Just(Mode::Paper)],
+        prop::array::uniform3(-0.3..0.3f64),
+        prop::array::uniform3(-1.0..1.0f64),
+        any::<bool>(),
+    );
+    let steps = (
+        0.02..0.3f64,
+        2.0..6.0f64,
+        2.0..6.0f64,
+        1.1..2.0f64,
+        0.3..0.9f64,
+        1.5..3.0f64,
+        0.0..0.7f64,
+    );
+    let terminal = (0.5..10.0f64, 1.5..10.0f64);
+    let budget = (50..=max_points, 6usize..2000, 5usize..500, 1usize..=64);
+    (shape, steps, terminal, budget).prop_map(
+        move |(
+            (method, mode, dp, w, close),
+            (dt, bmin, bwidth, grow, shrink, gap, merge),
+            (max_radius, bounding_box),
+            (max_points, max_curves, max_steps, max_retries),
+        )| {
+            let mut p = base.clone();
+            p.method = method;
+            p.mode = mode;
+            p.p0 = [base.p0[0] + dp[0], base.p0[1] + dp[1], base.p0[2] + dp[2]];
+            p.w00 = [1.0 + 0.5 * w[0], w[1], w[2]];
+            p.dt = dt;
+            p.beta_min = bmin.to_radians();
+            p.beta_max = (bmin + bwidth).to_radians();
+            p.grow = grow;
+            p.shrink = shrink;
+            p.gap = gap;
+            p.merge = merge.min(0.45 * gap);
+            p.terminal.max_radius = max_radius;
+            p.terminal.bounding_box = bounding_box;
+            p.terminal.close = close;
+            p.budget = Budget {
+                max_points,
+                max_curves,
+                max_steps_per_curve: max_steps,
+                max_retries,
+            };
+            p
+        },
+    )
+}
+
+#[test]
+fn linear_invariants_give_valid_meshes_or_typed_errors() {
+    let strategy = (
+        linear_invariant(),
+        prop_oneof![
+            params_near(Preset::Fig3, 20_000),
+            params_near(Preset::Fig1, 20_000)
+        ],
+    );
+    let (ok, err) = run_cases(96, strategy);
+    assert!(
+        ok >= (ok + err) / 2,
+        "only {ok} of {} cases meshed",
+        ok + err
+    );
+}
+
+#[test]
+fn hamiltonian_invariants_give_valid_meshes_or_typed_errors() {
+    let strategy = (
+        hamiltonian_invariant(),
+        prop_oneof![
+            params_near(Preset::Fig6, 20_000),
+            params_near(Preset::Fig4, 20_000)
+        ],
+    );
+    let (ok, err) = run_cases(96, strategy);
+    assert!(
+        ok >= (ok + err) / 2,
+        "only {ok} of {} cases meshed",
+        ok + err
+    );
+}
+
+#[test]
+fn tight_budgets_are_respected() {
+    // Budgets small enough that most runs hit one of them.
+    let strategy = (
+        prop_oneof![linear_invariant(), hamiltonian_invariant()],
+        (params_near(Preset::Fig3, 300), 1usize..20, 1usize..40).prop_map(
+            |(mut p, curves, steps)| {
+                p.budget.max_curves = curves.max(match p.method {
+                    Method::Previous { curves } => curves,
+                    Method::Proposed => 6,
+                });
+                p.budget.max_steps_per_curve = steps;
+                p
+            },
+        ),
+    );
+    let (ok, err) = run_cases(128, strategy);
+    assert!(
+        ok >= (ok + err) / 2,
+        "only {ok} of {} cases meshed",
+        ok + err
+    );
+}
+
+#[test]
+fn invalid_parameters_give_the_validation_error() {
+    // One parameter pushed out of its allowed range: the run must return exactly the error
+    // `MeshParams::validate` names, for every invariant.
+    let broken = (params_near(Preset::Fig3, 2_000), 0usize..12, -2.0..2.0f64).prop_map(
+        |(mut p, which, x)| {
+            match which {
+                0 => p.dt = -x.abs(),
+                1 => p.dt_min = 0.0,
+                2 => p.dt_max = p.dt_min * 0.5,
+                3 => p.beta_min = p.beta_max + x.abs(),
+                4 => p.beta_max = PI / 2.0 + x.abs(),
+                5 => p.grow = 1.0 - x.abs(),
+                6 => p.shrink = 1.0 + x.abs(),
+                7 => p.merge = p.gap,
+                8 => p.p0[1] = f64::NAN,
+                9 => p.terminal.max_radius = -x.abs(),
+                10 => p.budget.max_points = 0,
+                _ => p.method = Method::Previous { curves: 2 },
+            }
+            p
+        },
+    );
+    let strategy = (
+        prop_oneof![linear_invariant(), hamiltonian_invariant()],
+        broken,
+    );
+    // `check_run` asserts that each error is exactly `params.validate()`'s.
+    let (ok, err) = run_cases(64, strategy);
+    assert_eq!(ok, 0, "invalid parameters produced a mesh");
+    assert!(err > 0);
+}
+
+#[test]
+fn the_presets_themselves_pass_the_checks() {
+    for preset in [Preset::Fig1, Preset::Fig3, Preset::Fig4, Preset::Fig6] {
+        let mut params = preset.params();
+        params.budget.max_points = 20_000;
+        let field = LieField::<f64>::new(&preset.invariant());
+        let result = liemesh::run(&field, &params);
+        check_run(&params, &result).unwrap_or_else(|v| panic!("{preset}: {v}"));
+        assert!(result.is_ok(), "{preset}: {result:?}");
+    }
+}

@@ -1,0 +1,258 @@
+//! Regression tests for engine bugs found by the property tests (`tests/properties.rs`) and
+//! the fuzz targets (`fuzz/`). Each is named after the behaviour it pins down.
+
+use liemesh::model::{Invariant, LieField};
+use liemesh::preset::Preset;
+use liemesh::sample::Samples;
+use liemesh::scalar::Vec3;
+use liemesh::{Budget, MeshError, MeshParams, Method, Mode, Terminal};
+
+fn sphere() -> LieField<f64> {
+    LieField::new(&Preset::Fig3.invariant())
+}
+
+/// Found by `linear_invariants_give_valid_meshes_or_typed_errors`: the start point of an
+/// inserted curve was not checked against the terminal conditions, so inserted points lay
+/// beyond `max_radius`.
+#[test]
+fn inserted_curves_stop_at_the_maximum_radius() {
+    let params = MeshParams {
+        mode: Mode::Paper,
+        terminal: Terminal {
+            max_radius: 0.8,
+            ..Preset::Fig3.params().terminal
+        },
+        ..Preset::Fig3.params()
+    };
+    let run = liemesh::run(&sphere(), &params).unwrap();
+    assert!(run.samples.curves.iter().any(|c| c.parent.is_some()));
+    for (i, pr) in run.samples.provenance.iter().enumerate() {
+        assert!(pr.s <= 0.8, "point {i}: {pr:?}");
+    }
+}
+
+/// Found by `linear_invariants_give_valid_meshes_or_typed_errors` (the shrunk case): an
+/// inserted curve started outside the bounding box.
+#[test]
+fn inserted_curves_start_inside_the_bounding_box() {
+    let invariant = Invariant::from_numbers(&[
+        -1.0378999111189038,
+        0.9521422827397498,
+        1.995768559334771,
+        0.0,
+        0.0,
+        0.0,
+    ])
+    .unwrap();
+    let params = MeshParams {
+        method: Method::Proposed,
+        mode: Mode::Paper,
+        p0: [
+            -0.2365647051882535,
+            -0.02296298362665366,
+            0.7255660114508851,
+        ],
+        w00: [1.096528741597128, 0.6236057306993746, 0.45122594121145926],
+        dt: 0.2704924467312629,
+        dt_min: 0.001,
+        dt_max: 1.0,
+        beta_min: 0.08638554833151653,
+        beta_max: 0.15097661069596774,
+        grow: 1.2751268609420658,
+        shrink: 0.30917689534243126,
+        gap: 1.5,
+        merge: 0.0,
+        terminal: Terminal {
+            max_radius: 9.074743133661473,
+            bounding_box: 1.5,
+            close: false,
+        },
+        budget: Budget {
+            max_points: 674,
+            max_curves: 97,
+            max_steps_per_curve: 18,
+            max_retries: 2,
+        },
+    };
+    let run = liemesh::run(&LieField::<f64>::new(&invariant), &params).unwrap();
+    for (i, p) in run.samples.points.iter().enumerate().skip(1) {
+        let p = p.to_f64();
+        assert!(p.iter().all(|x| x.abs() <= 1.5), "point {i} = {p:?}");
+    }
+}
+
+/// Found by `hamiltonian_invariants_give_valid_meshes_or_typed_errors`: the previous method
+/// with more curves than `max_curves` (or the proposed method's 6 with fewer) traced them
+/// all, breaking the curve budget. It is now a parameter error.
+#[test]
+fn a_curve_budget_below_the_initial_fan_is_a_parameter_error() {
+    let with = |method, max_curves| {
+        let mut p = Preset::Fig3.params();
+        p.method = method;
+        p.budget.max_curves = max_curves;
+        p.budget.max_points = 2_000;
+        p
+    };
+    for (method, max_curves) in [(Method::Previous { curves: 17 }, 6), (Method::Proposed, 5)] {
+        let params = with(method, max_curves);
+        let err = liemesh::run(&sphere(), &params).unwrap_err();
+        assert!(
+            matches!(
+                err,
+                MeshError::OutOfRange {
+                    name: "max_curves",
+                    ..
+                }
+            ),
+            "{err}"
+        );
+        assert_eq!(Err(err), params.validate());
+    }
+    for (method, max_curves) in [(Method::Previous { curves: 17 }, 17), (Method::Proposed, 6)] {
+        let run = liemesh::run(&sphere(), &with(method, max_curves)).unwrap();
+        assert!(run.samples.curves.len() <= max_curves);
+    }
+}
+
+fn fig3_samples() -> Samples<f64> {
+    let mut params = Preset::Fig3.params();
+    params.budget.max_points = 200;
+    liemesh::sample::sample(&sphere(), &params).unwrap()
+}
+
+/// Found while writing the `triangulate` fuzz target: `triangulate` indexed hand-built
+/// samples without checking them and panicked on an empty curve, a curve naming a missing
+/// point or vectors of different lengths; NaN points became NaN vertices.
+#[test]
+fn triangulating_inconsistent_samples_is_an_error_not_a_panic() {
+    type Edit = fn(&mut Samples<f64>);
+    let edits: [(&str, Edit); 5] = [
+        ("empty curve", |s| s.curves[2].points.clear()),
+        ("missing point", |s| s.curves[0].points.push(1_000_000)),
+        ("short normals", |s| {
+            s.normals.pop();
+        }),
+        ("short provenance", |s| s.provenance.truncate(3)),
+        ("NaN point", |s| s.points[5] = Vec3::new(f64::NAN, 0.0, 1.0)),
+    ];
+    assert!(liemesh::triangulate::triangulate(&fig3_samples(), true, true).is_ok());
+    for (what, edit) in edits {
+        let mut s = fig3_samples();
+        edit(&mut s);
+        for improve in [false, true] {
+            match liemesh::triangulate::triangulate(&s, true, improve) {
+                Err(MeshError::Triangulation(msg)) => assert!(!msg.is_empty()),
+                other => panic!("{what}: {other:?}"),
+            }
+        }
+    }
+}
+
+/// Found by `linear_invariants_give_valid_meshes_or_typed_errors` (seed 1): when only two
+/// curves were left alive, a wide gap between them was filled on both sides of the curve
+/// that stepped, so two inserted curves started at the same point, traced the same points and
+/// gave zero-area triangles.
+#[test]
+fn two_remaining_curves_get_one_inserted_curve_between_them() {
+    let invariant = Invariant::from_numbers(&[
+        -1.311298495867849,
+        0.731846639288721,
+        0.41061682643575687,
+        -0.844302714808464,
+        -2.4928951991286867,
+        -1.4273784865890942,
+    ])
+    .unwrap();
+    let params = MeshParams {
+        method: Method::Proposed,
+        mode: Mode::Paper,
+        p0: [
+            -0.16254485672443633,
+            0.15419507690898088,
+            1.1753886229716555,
+        ],
+        w00: [0.6146770315061088, 0.7768643088756753, -0.2695077193742007],
+        dt: 0.26977667517694565,
+        dt_min: 0.001,
+        dt_max: 1.0,
+        beta_min: 0.09749869984728832,
+        beta_max: 0.19997543601628992,
+        grow: 1.9622919907908094,
+        shrink: 0.6586000290310365,
+        gap: 1.8294067200297834,
+        merge: 0.34599640134936843,
+        terminal: Terminal {
+            max_radius: 6.419210947589834,
+            bounding_box: 2.4753959100926584,
+            close: false,
+        },
+        budget: Budget {
+            max_points: 1565,
+            max_curves: 327,
+            max_steps_per_curve: 15,
+            max_retries: 1,
+        },
+    };
+    let run = liemesh::run(&LieField::<f64>::new(&invariant), &params).unwrap();
+    let mut seen = std::collections::HashMap::new();
+    for (i, p) in run.samples.points.iter().enumerate() {
+        let key = p.to_f64().map(f64::to_bits);
+        if let Some(j) = seen.insert(key, i) {
+            panic!("points {j} and {i} coincide at {:?}", p.to_f64());
+        }
+    }
+    liemesh::fuzz_checks::check_mesh(&run.mesh).unwrap();
+}
+
+/// Found by the `mesher` fuzz target (`fuzz/corpus/mesher/crash-fig1-three-curves-closing-
+/// orientation`): with three curves on the sphere one curve overshoots the south pole, the
+/// front runs counter-clockwise in the projection across the hole, and the closing triangles
+/// (counter-clockwise in that projection) were oriented against chart 1.
+#[test]
+fn closing_a_hole_keeps_the_orientation_of_chart_one() {
+    let params = MeshParams {
+        method: Method::Previous { curves: 3 },
+        budget: Budget {
+            max_points: 1500,
+            max_curves: 200,
+            max_steps_per_curve: 400,
+            max_retries: 64,
+        },
+        ..Preset::Fig1.params()
+    };
+    let run = liemesh::run(&sphere(), &params).unwrap();
+    let topology = liemesh::quality::Topology::of(&run.mesh);
+    assert_eq!(topology.orientation_flips, 0, "{topology:?}");
+    assert_eq!(topology.non_manifold_edges, 0, "{topology:?}");
+    // Three curves leave a hole the size of a hemisphere; ears across it would face against
+    // the field, so the mesher may leave it open — but whatever it closes must be oriented.
+    assert_eq!(
+        topology.closed,
+        !run.chart.closing.is_empty(),
+        "{topology:?}"
+    );
+}
+
+/// Found by the `mesher` fuzz target (a subnormal Δt made one run take minutes): the neighbour
+/// grid's cells are Δt wide, and a closure query of many cells was clamped to 64 cells each
+/// way — both slow (129³ lookups per step) and not a superset, so collisions farther than 64
+/// cells were missed. In the default mode Δt only sizes that grid (the step comes from the
+/// predicted angle), so the samples must not depend on it.
+#[test]
+fn the_closure_test_finds_neighbours_whatever_the_initial_step() {
+    let reference = liemesh::run(&sphere(), &Preset::Fig3.params()).unwrap();
+    for dt in [0.0005, 1e-300] {
+        let params = MeshParams {
+            dt,
+            ..Preset::Fig3.params()
+        };
+        let start = std::time::Instant::now();
+        let run = liemesh::run(&sphere(), &params).unwrap();
+        assert_eq!(run.mesh, reference.mesh, "Δt = {dt}");
+        assert!(
+            start.elapsed().as_secs_f64() < 10.0,
+            "Δt = {dt}: {:?}",
+            start.elapsed()
+        );
+    }
+}

@@ -1,0 +1,173 @@
+//! Delaunay output (DESIGN.md §4): insta snapshots of the six presets' triangulations, and the
+//! empty-circumcircle property of every chart triangulation, checked with exact predicates.
+//!
+//! The snapshots live in the top-level `snapshots/` folder. After an intended change of the
+//! meshes, review and accept the new ones with `cargo insta review` (or regenerate them with
+//! `INSTA_UPDATE=always cargo test --test snapshots` and inspect the diff).
+
+use liemesh::fuzz_checks::{check_chart, check_chart_delaunay};
+use liemesh::model::LieField;
+use liemesh::preset::Preset;
+use liemesh::quality::Topology;
+use liemesh::{MeshParams, MeshRun, Mode};
+use std::fmt::Write as _;
+
+fn run(preset: Preset, params: &MeshParams) -> MeshRun<f64> {
+    let field = LieField::<f64>::new(&preset.invariant());
+    liemesh::run(&field, params).unwrap_or_else(|e| panic!("{preset}: {e}"))
+}
+
+/// A coordinate rounded to 1e-9, without a sign on zero.
+fn coord(x: f64) -> String {
+    let s = format!("{x:.9}");
+    if s.trim_start_matches('-')
+        .chars()
+        .all(|c| c == '0' || c == '.')
+    {
+        s.trim_start_matches('-').to_string()
+    } else {
+        s
+    }
+}
+
+/// The text of a snapshot: the report's counts, then the triangles (each rotated so that its
+/// smallest index comes first, keeping the orientation, then sorted), then the vertices.
+fn snapshot_text(run: &MeshRun<f64>) -> String {
+    let mesh = &run.mesh;
+    let topo = Topology::of(mesh);
+    let mut out = String::new();
+    writeln!(out, "vertices: {}", mesh.vertices.len()).unwrap();
+    writeln!(out, "triangles: {}", mesh.triangles.len()).unwrap();
+    writeln!(out, "curves: {}", run.samples.curves.len()).unwrap();
+    writeln!(out, "closed: {}", topo.closed).unwrap();
+    writeln!(out, "euler_characteristic: {}", topo.euler_characteristic).unwrap();
+    writeln!(out, "boundary_loops: {}", topo.boundary_loops).unwrap();
+    let mut triangles: Vec<[u32; 3]> = mesh
+        .triangles
+        .iter()
+        .map(|t| {
+            let k = (0..3).min_by_key(|&k| t[k]).unwrap();
+            [t[k], t[(k + 1) % 3], t[(k + 2) % 3]]
+        })
+        .collect();
+    triangles.sort_unstable();
+    writeln!(out, "triangles (a b c, counter-clockwise):").unwrap();
+    for [a, b, c] in triangles {
+        writeln!(out, "{a} {b} {c}").unwrap();
+    }
+    writeln!(out, "vertices (x y z):").unwrap();
+    for v in &mesh.vertices {
+        writeln!(out, "{} {} {}", coord(v[0]), coord(v[1]), coord(v[2])).unwrap();
+    }
+    out
+}
+
+fn assert_preset_snapshot(preset: Preset) {
+    let text = snapshot_text(&run(preset, &preset.params()));
+    insta::with_settings!({
+        snapshot_path => "../snapshots",
+        prepend_module_to_snapshot => false,
+        description => format!("liemesh mesh --preset {preset}: counts, canonical triangles, vertices rounded to 1e-9"),
+        omit_expression => true,
+    }, {
+        insta::assert_snapshot!(preset.name(), text);
+    });
+}
+
+#[test]
+fn fig1_triangulation_matches_its_snapshot() {
+    assert_preset_snapshot(Preset::Fig1);
+}
+
+#[test]
+fn fig2_triangulation_matches_its_snapshot() {
+    assert_preset_snapshot(Preset::Fig2);
+}
+
+#[test]
+fn fig3_triangulation_matches_its_snapshot() {
+    assert_preset_snapshot(Preset::Fig3);
+}
+
+#[test]
+fn fig4_triangulation_matches_its_snapshot() {
+    assert_preset_snapshot(Preset::Fig4);
+}
+
+#[test]
+fn fig5_triangulation_matches_its_snapshot() {
+    assert_preset_snapshot(Preset::Fig5);
+}
+
+#[test]
+fn fig6_triangulation_matches_its_snapshot() {
+    assert_preset_snapshot(Preset::Fig6);
+}
+
+/// The snapshots can fail: changing a preset's parameters changes its triangulation and so
+/// its snapshot text, while the same parameters give the same text twice (deterministic
+/// output). In the default mode every step length comes from the predicted angle and Δt
+/// does not enter the triangulation, so Δt is changed in the paper mode, where it is the
+/// first trial step.
+#[test]
+fn a_changed_triangulation_changes_the_snapshot() {
+    let params = Preset::Fig3.params();
+    let base = snapshot_text(&run(Preset::Fig3, &params));
+    assert!(
+        base == snapshot_text(&run(Preset::Fig3, &params)),
+        "not deterministic"
+    );
+    let narrower_band = MeshParams {
+        beta_max: params.beta_max * 0.9,
+        ..params.clone()
+    };
+    assert!(base != snapshot_text(&run(Preset::Fig3, &narrower_band)));
+    let paper = MeshParams {
+        mode: Mode::Paper,
+        ..params
+    };
+    let paper_text = snapshot_text(&run(Preset::Fig3, &paper));
+    assert!(base != paper_text);
+    let smaller_step = MeshParams {
+        dt: paper.dt * 0.9,
+        ..paper
+    };
+    assert!(paper_text != snapshot_text(&run(Preset::Fig3, &smaller_step)));
+}
+
+#[test]
+fn snapshot_triangles_are_canonical() {
+    let text = snapshot_text(&run(Preset::Fig1, &Preset::Fig1.params()));
+    let triangles: Vec<[u32; 3]> = text
+        .lines()
+        .skip_while(|l| !l.starts_with("triangles ("))
+        .skip(1)
+        .take_while(|l| !l.starts_with("vertices ("))
+        .map(|l| {
+            let v: Vec<u32> = l.split(' ').map(|x| x.parse().unwrap()).collect();
+            [v[0], v[1], v[2]]
+        })
+        .collect();
+    assert!(!triangles.is_empty());
+    assert!(triangles.iter().all(|t| t[0] < t[1] && t[0] < t[2]));
+    assert!(triangles.windows(2).all(|w| w[0] < w[1]));
+}
+
+/// Every chart-1 triangulation is a constrained Delaunay triangulation: each interior edge
+/// that is not a front constraint has neither opposite vertex strictly inside the other
+/// triangle's circumcircle (exact `robust` predicates, the ones spade uses), and every
+/// triangle is strictly counter-clockwise in the chart.
+#[test]
+fn chart_triangles_have_empty_circumcircles() {
+    for preset in Preset::ALL {
+        let r = run(preset, &preset.params());
+        check_chart(&r.chart, r.samples.points.len()).unwrap_or_else(|v| panic!("{preset}: {v}"));
+        let edges = check_chart_delaunay(&r.chart).unwrap_or_else(|v| panic!("{preset}: {v}"));
+        // Nearly every chart edge is interior: the check is not vacuous.
+        assert!(
+            edges >= r.chart.triangles.len(),
+            "{preset}: only {edges} edges checked for {} triangles",
+            r.chart.triangles.len()
+        );
+    }
+}
