@@ -87,12 +87,22 @@ pub fn triangulate<T: Scalar>(
         }
     }
 
-    let mut all = triangles.clone();
-    all.extend_from_slice(&closing);
-    if improve {
-        let normals: Vec<[f64; 3]> = samples.normals.iter().map(|v| v.to_f64()).collect();
-        let budget = 8 * all.len() + 64;
-        flip::flip_to_surface_delaunay(&pos, &normals, &mut all, budget);
+    let normals: Vec<[f64; 3]> = samples.normals.iter().map(|v| v.to_f64()).collect();
+    let finish = |closing: &[[u32; 3]]| {
+        let mut all = triangles.clone();
+        all.extend_from_slice(closing);
+        if improve {
+            let budget = 8 * all.len() + 64;
+            flip::flip_to_surface_delaunay(&pos, &normals, &mut all, budget);
+        }
+        all
+    };
+    let mut all = finish(&closing);
+    // Closing triangles across a thin, twisted hole can face against the field, and flips
+    // cannot always turn them round: then the hole stays open rather than folded.
+    if !closing.is_empty() && folds(&all, &pos, &normals) {
+        closing.clear();
+        all = finish(&closing);
     }
     let mesh = assemble(samples, &pos, &all);
     Ok((
@@ -475,14 +485,6 @@ fn clip_ears(
         ring.remove(i);
     }
     out.push([ring[2].0, ring[1].0, ring[0].0]);
-    // Ears across a thin, twisted band can face against the field: then leave the hole open.
-    let mut normal_of = vec![[0.0; 3]; pos.len()];
-    for (&v, n) in front.iter().zip(normals) {
-        normal_of[v as usize] = *n;
-    }
-    if folds(&out, pos, &normal_of) {
-        return Vec::new();
-    }
     out
 }
 
