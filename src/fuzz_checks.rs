@@ -356,7 +356,8 @@ pub fn mesher(data: &[u8]) -> Result<(), Violation> {
 /// - the samples satisfy [`check_samples`] (budgets, step band, bookkeeping);
 /// - the chart triangulation satisfies [`check_chart`];
 /// - the mesh satisfies [`check_mesh`] (no NaN, no degenerate or duplicate triangles, manifold,
-///   consistently oriented) and is made of exactly the chart and closing triangles.
+///   consistently oriented), has as many triangles as the chart and closing triangulations, and
+///   its vertices are the run's working-precision vertices rounded to `f64`.
 pub fn check_run(
     params: &MeshParams,
     result: &Result<MeshRun<f64>, MeshError>,
@@ -395,6 +396,17 @@ pub fn check_run(
     let n = run.samples.points.len();
     check_chart(&run.chart, n)?;
     check_mesh(&run.mesh)?;
+    ensure!(
+        run.vertices.len() == run.mesh.vertices.len()
+            && run
+                .vertices
+                .iter()
+                .zip(&run.mesh.vertices)
+                .all(|(v, m)| v.to_f64() == *m),
+        "the working-precision vertices ({}) are not the mesh's ({}) rounded to f64",
+        run.vertices.len(),
+        run.mesh.vertices.len()
+    );
     ensure!(
         run.mesh.triangles.len() == run.chart.triangles.len() + run.chart.closing.len(),
         "the mesh has {} triangles, the charts {} + {}",

@@ -157,7 +157,7 @@ fn linear_invariants_give_valid_meshes_or_typed_errors() {
             params_near(Preset::Fig1, 20_000)
         ],
     );
-    let (ok, err) = run_cases(96, strategy);
+    let (ok, err) = run_cases(128, strategy);
     assert!(
         ok >= (ok + err) / 2,
         "only {ok} of {} cases meshed",
@@ -174,7 +174,7 @@ fn hamiltonian_invariants_give_valid_meshes_or_typed_errors() {
             params_near(Preset::Fig4, 20_000)
         ],
     );
-    let (ok, err) = run_cases(96, strategy);
+    let (ok, err) = run_cases(128, strategy);
     assert!(
         ok >= (ok + err) / 2,
         "only {ok} of {} cases meshed",

@@ -257,11 +257,19 @@ fn chart_triangles(chart: &[[f64; 2]], front: &[u32]) -> Result<Vec<[u32; 3]>, M
         let [a, b, c] = face.vertices();
         let (pa, pb, pc) = (a.position(), b.position(), c.position());
         let centroid = [(pa.x + pb.x + pc.x) / 3.0, (pa.y + pb.y + pc.y) / 3.0];
-        if inside(centroid) {
+        if inside(centroid) && !rounding_sliver(pa, pb, pc) {
             triangles.push([a.data().index, b.data().index, c.data().index]);
         }
     }
     Ok(triangles)
+}
+
+/// Whether the chart triangle's area is at the level of rounding: three points on a line,
+/// such as `p0` and the first points of the curves at θ = 0 and θ = π (whose `sin π` is not
+/// exactly 0), which spade keeps as a hull triangle but which has no area in space.
+fn rounding_sliver(a: Point2<f64>, b: Point2<f64>, c: Point2<f64>) -> bool {
+    let (u, v) = ([b.x - a.x, b.y - a.y], [c.x - a.x, c.y - a.y]);
+    cross2(u, v).abs() <= 1e-12 * u[0].hypot(u[1]) * v[0].hypot(v[1])
 }
 
 /// Whether the polygon is star-shaped about the origin with vertices in counter-clockwise
