@@ -26,7 +26,8 @@
 use liemesh::fuzz_checks::check_run;
 use liemesh::model::{Invariant, LieField};
 use liemesh::preset::{Preset, FIG46_INVARIANT};
-use liemesh::{Budget, MeshParams, Method, Mode};
+use liemesh::sample::CurveEnd;
+use liemesh::{Budget, MeshParams, MeshRun, Method, Mode};
 use proptest::prelude::*;
 use proptest::test_runner::{Config, RngSeed, TestCaseError, TestRunner};
 use std::cell::Cell;
@@ -34,11 +35,13 @@ use std::f64::consts::PI;
 
 const SEED: u64 = 0x11e_3e54;
 
-/// Runs `cases` cases of `strategy` through the mesher; returns (meshes, errors).
+/// Runs `cases` cases of `strategy` through the mesher; returns (meshes, errors, meshes for
+/// which `mark` holds).
 fn run_cases(
     cases: u32,
     strategy: impl Strategy<Value = (Vec<f64>, MeshParams)>,
-) -> (usize, usize) {
+    mark: impl Fn(&MeshRun<f64>) -> bool,
+) -> (usize, usize, usize) {
     let mut config = Config {
         failure_persistence: None,
         max_shrink_iters: 256,
@@ -50,7 +53,7 @@ fn run_cases(
     if std::env::var_os("PROPTEST_CASES").is_none() {
         config.cases = cases;
     }
-    let (ok, err) = (Cell::new(0), Cell::new(0));
+    let (ok, err, marked) = (Cell::new(0), Cell::new(0), Cell::new(0));
     let mut runner = TestRunner::new(config);
     let result = runner.run(&strategy, |(numbers, params)| {
         let invariant = Invariant::from_numbers(&numbers)
@@ -59,7 +62,10 @@ fn run_cases(
         let result = liemesh::run(&field, &params);
         check_run(&params, &result).map_err(|v| TestCaseError::fail(v.0))?;
         match result {
-            Ok(_) => ok.set(ok.get() + 1),
+            Ok(run) => {
+                ok.set(ok.get() + 1);
+                marked.set(marked.get() + usize::from(mark(&run)));
+            }
             Err(_) => err.set(err.get() + 1),
         }
         Ok(())
@@ -67,7 +73,7 @@ fn run_cases(
     if let Err(e) = result {
         panic!("{e}");
     }
-    (ok.get(), err.get())
+    (ok.get(), err.get(), marked.get())
 }
 
 /// A linear invariant: λ's of either sign around the paper's magnitudes, any angles.
@@ -157,7 +163,7 @@ fn linear_invariants_give_valid_meshes_or_typed_errors() {
             params_near(Preset::Fig1, 20_000)
         ],
     );
-    let (ok, err) = run_cases(128, strategy);
+    let (ok, err, _) = run_cases(256, strategy, |_| true);
     assert!(
         ok >= (ok + err) / 2,
         "only {ok} of {} cases meshed",
@@ -174,7 +180,7 @@ fn hamiltonian_invariants_give_valid_meshes_or_typed_errors() {
             params_near(Preset::Fig4, 20_000)
         ],
     );
-    let (ok, err) = run_cases(128, strategy);
+    let (ok, err, _) = run_cases(256, strategy, |_| true);
     assert!(
         ok >= (ok + err) / 2,
         "only {ok} of {} cases meshed",
@@ -198,12 +204,15 @@ fn tight_budgets_are_respected() {
             },
         ),
     );
-    let (ok, err) = run_cases(128, strategy);
+    let (ok, err, hit) = run_cases(256, strategy, |run| {
+        run.samples.hit_point_budget || run.samples.curves.iter().any(|c| c.end == CurveEnd::Budget)
+    });
     assert!(
         ok >= (ok + err) / 2,
         "only {ok} of {} cases meshed",
         ok + err
     );
+    assert!(hit >= ok / 2, "only {hit} of {ok} meshes ran into a budget");
 }
 
 #[test]
@@ -234,7 +243,7 @@ fn invalid_parameters_give_the_validation_error() {
         broken,
     );
     // `check_run` asserts that each error is exactly `params.validate()`'s.
-    let (ok, err) = run_cases(64, strategy);
+    let (ok, err, _) = run_cases(128, strategy, |_| true);
     assert_eq!(ok, 0, "invalid parameters produced a mesh");
     assert!(err > 0);
 }

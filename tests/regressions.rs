@@ -299,3 +299,41 @@ fn collinear_chart_points_give_no_sliver_triangle() {
     assert!(!run.mesh.triangles.is_empty());
     liemesh::fuzz_checks::check_mesh(&run.mesh).unwrap();
 }
+
+/// Found by the `mesher` fuzz target (`fuzz/corpus/mesher/crash-straight-curves-collinear-in-
+/// space`): on this degenerate field (entries from 1e-267 to 1e104) the paper-mode curves run
+/// straight, and a chart triangle joined a curve's two points to a neighbour's point on the
+/// same line in space — a triangle of exactly zero area and no normal. Such triangles are
+/// now left out of the mesh.
+#[test]
+fn points_on_a_line_in_space_give_no_zero_area_triangle() {
+    let invariant = Invariant::from_numbers(&[
+        -0.875,
+        1.0989683154716244e104,
+        0.0,
+        -1.47392528439439e-267,
+        0.0,
+        -1.875,
+        6.303923380431546,
+        0.0,
+        -1.875,
+        0.0,
+        0.0,
+        7.416912861906527e-309,
+    ])
+    .unwrap();
+    let params = MeshParams {
+        mode: Mode::Paper,
+        p0: [1.26e-321, 0.0, 1.0],
+        budget: Budget {
+            max_points: 800,
+            max_curves: 120,
+            max_steps_per_curve: 200,
+            max_retries: 64,
+        },
+        ..Preset::Fig1.params()
+    };
+    let run = liemesh::run(&LieField::<f64>::new(&invariant), &params).unwrap();
+    assert!(!run.mesh.triangles.is_empty());
+    liemesh::fuzz_checks::check_mesh(&run.mesh).unwrap();
+}

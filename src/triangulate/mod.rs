@@ -104,6 +104,12 @@ pub fn triangulate<T: Scalar>(
         closing.clear();
         all = finish(&closing);
     }
+    // Three points on a line in space (curves that ran straight along a degenerate field)
+    // make a triangle of no area and no normal, however good it looks in the chart.
+    all.retain(|t| {
+        let [a, b, c] = t.map(|i| pos[i as usize]);
+        cross3(sub3(b, a), sub3(c, a)) != [0.0; 3]
+    });
     let mesh = assemble(samples, &pos, &all);
     Ok((
         mesh,
