@@ -12,7 +12,7 @@ mod topology;
 pub use fidelity::{
     diagonal, drift, face_normal_error, integrability_defect, step_quality, Drift, StepQuality,
 };
-pub use recover::{decompose, mesh_normals, recover, Recovery};
+pub use recover::{decompose, jet_normals, mesh_normals, recover, Recovery};
 pub use shape::Shape;
 pub use topology::Topology;
 

@@ -1,7 +1,8 @@
 //! Invariants recovered from a mesh alone (the paper's notion of quality).
 //!
-//! Vertex normals are estimated from the mesh (face normals with Max's weights, never the
-//! stored field normals). Since `n ∥ A p + B (p∘p)`, each vertex gives three equations
+//! Vertex normals are estimated from the mesh alone, never from the stored field normals: face
+//! normals with Max's weights give a first tangent plane, over which a cubic height function
+//! fitted to the two-ring gives the normal to third order ([`jet_normals`]). Since `n ∥ A p + B (p∘p)`, each vertex gives three equations
 //! `n × (A p + B (p∘p)) = 0` that are linear in the entries of `A` (and `B`); the least-squares
 //! solution of unit norm is the right singular vector of the smallest singular value. It is
 //! scaled to the reference by least squares and decomposed as `A = diag(λ) Rx(θ) Ry(φ) Rz(ψ)`.
@@ -69,10 +70,134 @@ pub fn mesh_normals(mesh: &Mesh) -> Vec<[f64; 3]> {
         .collect()
 }
 
+/// Vertex normals of `mesh` from its vertex positions, third-order accurate: around each
+/// vertex, the surface is fitted as a height function of degree three over the tangent plane of
+/// [`mesh_normals`] (an osculating jet, through the vertex, on its two-ring), and the normal is
+/// the jet's at the vertex. Where the two-ring has too few points for a well-posed fit (fewer
+/// than 12, as at the corner of an open mesh), the [`mesh_normals`] normal is kept.
+pub fn jet_normals(mesh: &Mesh) -> Vec<[f64; 3]> {
+    let first = mesh_normals(mesh);
+    let n = mesh.vertices.len();
+    let mut neighbours: Vec<Vec<u32>> = vec![Vec::new(); n];
+    for t in &mesh.triangles {
+        for k in 0..3 {
+            let (a, b) = (t[k], t[(k + 1) % 3]);
+            neighbours[a as usize].push(b);
+            neighbours[b as usize].push(a);
+        }
+    }
+    for list in &mut neighbours {
+        list.sort_unstable();
+        list.dedup();
+    }
+    let mut ring: Vec<u32> = Vec::new();
+    let mut rows: Vec<[f64; 9]> = Vec::new();
+    let mut rhs: Vec<f64> = Vec::new();
+    (0..n)
+        .map(|i| {
+            let n0 = first[i];
+            if n0 == [0.0; 3] {
+                return n0;
+            }
+            ring.clear();
+            for &j in &neighbours[i] {
+                ring.push(j);
+                ring.extend(&neighbours[j as usize]);
+            }
+            ring.sort_unstable();
+            ring.dedup();
+            ring.retain(|&j| j as usize != i);
+            if ring.len() < 12 {
+                return n0;
+            }
+            // Tangent frame (t1, t2, n0).
+            let helper = if n0[0].abs() < 0.6 {
+                [1.0, 0.0, 0.0]
+            } else {
+                [0.0, 1.0, 0.0]
+            };
+            let t1 = normalize(cross(helper, n0));
+            let t2 = cross(n0, t1);
+            let p = mesh.vertices[i];
+            let local: Vec<[f64; 3]> = ring
+                .iter()
+                .map(|&j| {
+                    let q = mesh.vertices[j as usize];
+                    let d = [q[0] - p[0], q[1] - p[1], q[2] - p[2]];
+                    [dot(d, t1), dot(d, t2), dot(d, n0)]
+                })
+                .collect();
+            // Uniform scaling keeps the slopes and conditions the monomials.
+            let r = local
+                .iter()
+                .map(|d| (d[0] * d[0] + d[1] * d[1]).sqrt())
+                .fold(0.0_f64, f64::max);
+            if r <= 0.0 {
+                return n0;
+            }
+            rows.clear();
+            rhs.clear();
+            for d in &local {
+                let (x, y, z) = (d[0] / r, d[1] / r, d[2] / r);
+                rows.push([
+                    x,
+                    y,
+                    x * x,
+                    x * y,
+                    y * y,
+                    x * x * x,
+                    x * x * y,
+                    x * y * y,
+                    y * y * y,
+                ]);
+                rhs.push(z);
+            }
+            let m = DMatrix::from_fn(rows.len(), 9, |a, b| rows[a][b]);
+            let b = nalgebra::DVector::from_column_slice(&rhs);
+            let svd = m.svd(true, true);
+            // Too few independent directions (points on a curve): keep the first estimate.
+            let smax = svd.singular_values.max();
+            if svd.singular_values.min() <= 1e-8 * smax {
+                return n0;
+            }
+            let Ok(x) = svd.solve(&b, 0.0) else {
+                return n0;
+            };
+            let (a1, a2) = (x[0], x[1]);
+            normalize([
+                n0[0] - a1 * t1[0] - a2 * t2[0],
+                n0[1] - a1 * t1[1] - a2 * t2[1],
+                n0[2] - a1 * t1[2] - a2 * t2[2],
+            ])
+        })
+        .collect()
+}
+
+fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+
+fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ]
+}
+
+fn normalize(a: [f64; 3]) -> [f64; 3] {
+    let l = dot(a, a).sqrt();
+    if l > 0.0 {
+        a.map(|x| x / l)
+    } else {
+        [0.0; 3]
+    }
+}
+
 /// Fits the field to `mesh`; `hamiltonian` adds the 9 entries of `B`. With a `reference`
 /// invariant, the fit is scaled to it and its relative error reported.
 pub fn recover(mesh: &Mesh, hamiltonian: bool, reference: Option<&Invariant>) -> Recovery {
-    let normals = mesh_normals(mesh);
+    let normals = jet_normals(mesh);
     let unknowns = if hamiltonian { 18 } else { 9 };
     let used: Vec<usize> = (0..mesh.vertices.len())
         .filter(|&i| normals[i] != [0.0; 3])
