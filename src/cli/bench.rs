@@ -24,6 +24,79 @@ pub struct BenchArgs {
     /// Only tiny workloads (~10^3 triangles, one repeat; for tests).
     #[arg(long)]
     pub tiny: bool,
+    /// Internal: mesh the sphere (`sphere`) or ellipsoid (`ellipsoid`) workload at this many
+    /// triangles and print this process's peak memory; `liemesh bench` runs itself with it so
+    /// that the peak belongs to that one mesh.
+    #[arg(long, hide = true, num_args = 2, value_names = ["WORKLOAD", "TRIANGLES"])]
+    pub memory_probe: Option<Vec<String>>,
+}
+
+/// Peak memory of one mesh, measured in a child process.
+#[derive(Debug, Clone, Serialize)]
+pub struct MemoryRow {
+    /// Name, e.g. `sphere-1e6`.
+    pub workload: String,
+    /// Triangles of the mesh.
+    pub triangles: usize,
+    /// The child's peak resident set (`VmHWM`), MB (10^6 bytes), including the executable.
+    pub peak_mb: f64,
+}
+
+/// The peak memory budget of issue 6 for a 10^6-triangle mesh, MB.
+pub const MEMORY_BUDGET_MB: f64 = 200.0;
+
+/// This process's peak resident set in bytes (Linux `/proc/self/status`), if known.
+fn peak_resident_bytes() -> Option<u64> {
+    let status = std::fs::read_to_string("/proc/self/status").ok()?;
+    let line = status.lines().find(|l| l.starts_with("VmHWM:"))?;
+    let kb: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(kb * 1024)
+}
+
+/// The child side of [`memory_row`]: meshes the workload through [`crate::run`] (the whole
+/// pipeline, working-precision vertices included) and prints `triangles peak_bytes`.
+fn memory_probe(workload: &str, target: &str) -> Result<ExitCode, CliError> {
+    let ellipsoid = match workload {
+        "sphere" => false,
+        "ellipsoid" => true,
+        other => {
+            return Err(CliError::Usage(format!(
+                "unknown memory workload `{other}`"
+            )))
+        }
+    };
+    let target: usize = target
+        .parse()
+        .map_err(|_| CliError::Usage(format!("`{target}` is not a triangle count")))?;
+    let (inv, params) = workload_params(ellipsoid, target);
+    let run = crate::run(&LieField::<f64>::new(&inv), &params)?;
+    let peak = peak_resident_bytes().ok_or_else(|| {
+        CliError::Usage("peak memory needs Linux's /proc/self/status".to_string())
+    })?;
+    println!("{} {peak}", run.mesh.triangles.len());
+    Ok(ExitCode::SUCCESS)
+}
+
+/// Runs this executable with `--memory-probe` and reads the child's answer; `None` where the
+/// platform cannot tell.
+fn memory_row(ellipsoid: bool, target: usize, tag: &str) -> Option<MemoryRow> {
+    let workload = if ellipsoid { "ellipsoid" } else { "sphere" };
+    let out = std::process::Command::new(std::env::current_exe().ok()?)
+        .args(["bench", "--memory-probe", workload, &target.to_string()])
+        .output()
+        .ok()?;
+    if !out.status.success() {
+        return None;
+    }
+    let text = String::from_utf8(out.stdout).ok()?;
+    let mut words = text.split_whitespace();
+    let triangles = words.next()?.parse().ok()?;
+    let peak: f64 = words.next()?.parse().ok()?;
+    Some(MemoryRow {
+        workload: format!("{workload}-{tag}"),
+        triangles,
+        peak_mb: peak / 1e6,
+    })
 }
 
 /// One timed workload.
@@ -97,6 +170,9 @@ pub struct BenchReport {
     pub fidelity: Vec<FidelityRow>,
     /// The ratios.
     pub ratios: Ratios,
+    /// Peak memory of the largest sphere and ellipsoid meshes (empty where the platform cannot
+    /// tell).
+    pub memory: Vec<MemoryRow>,
 }
 
 /// Parameters for the sphere (`ellipsoid = false`) or the ellipsoid `(1, 4, 16, 0, 0, 0)`
@@ -327,16 +403,25 @@ pub fn measure(args: &BenchArgs) -> Result<BenchReport, CliError> {
         ellipsoid_scaling: scaling[1],
     };
     let fidelity = vec![fidelity(false, rep)?, fidelity(true, rep)?];
+    let &(target, tag, _) = sizes.last().expect("at least one size");
+    let memory = [false, true]
+        .into_iter()
+        .filter_map(|ellipsoid| memory_row(ellipsoid, target, tag))
+        .collect();
     Ok(BenchReport {
         rows,
         fig6_sampling_ms: fig6,
         fidelity,
         ratios,
+        memory,
     })
 }
 
 /// `liemesh bench`.
 pub fn run(args: &BenchArgs) -> Result<ExitCode, CliError> {
+    if let Some(probe) = &args.memory_probe {
+        return memory_probe(&probe[0], &probe[1]);
+    }
     let report = measure(args)?;
     if args.json {
         println!(
@@ -394,8 +479,9 @@ pub fn run(args: &BenchArgs) -> Result<ExitCode, CliError> {
     let r = &report.ratios;
     println!();
     println!("Dual<f64> / f64 sampling     {:.2}", r.dual_over_f64);
-    if let Some(m) = r.mpfr256_over_f64 {
-        println!("Mpfr<256> / f64 sampling     {m:.1}");
+    match r.mpfr256_over_f64 {
+        Some(m) => println!("Mpfr<256> / f64 sampling     {m:.1}"),
+        None => println!("Mpfr<256> / f64 sampling     (run with --features mpfr)"),
     }
     println!(
         "sphere    ns/tri largest / smallest  {:.2}",
@@ -405,5 +491,15 @@ pub fn run(args: &BenchArgs) -> Result<ExitCode, CliError> {
         "ellipsoid ns/tri largest / smallest  {:.2}",
         r.ellipsoid_scaling
     );
+    println!();
+    if report.memory.is_empty() {
+        println!("peak memory: not available on this platform");
+    }
+    for m in &report.memory {
+        println!(
+            "peak memory {:<14} {:>9} triangles {:>8.1} MB  (budget at 10^6 triangles: {MEMORY_BUDGET_MB} MB)",
+            m.workload, m.triangles, m.peak_mb
+        );
+    }
     Ok(ExitCode::SUCCESS)
 }

@@ -49,30 +49,34 @@ pub(crate) fn relax<T: Scalar, F: NormalField<T>>(
         start[v + 1] += start[v];
     }
     let mut fill: Vec<u32> = start[..n].to_vec();
+    // Out-neighbours: `b` once in `a`'s list per triangle with the directed edge `a → b`.
     let mut adj = vec![0u32; start[n] as usize];
-    // Undirected edges, one entry per use: an edge not used exactly twice is a boundary.
-    let mut edges: Vec<u64> = Vec::with_capacity(3 * mesh.triangles.len());
     for t in &mesh.triangles {
         for k in 0..3 {
             let (a, b) = (t[k], t[(k + 1) % 3]);
             adj[fill[a as usize] as usize] = b;
             fill[a as usize] += 1;
-            edges.push(((a.min(b) as u64) << 32) | a.max(b) as u64);
         }
     }
-    edges.sort_unstable();
+    drop(fill);
+    for v in 0..n {
+        adj[start[v] as usize..start[v + 1] as usize].sort_unstable();
+    }
+    // An edge used by other than exactly two triangles (`a → b` and `b → a` counted
+    // together) is a boundary, or worse: both ends stay fixed.
+    let uses = |a: u32, b: u32| {
+        let list = &adj[start[a as usize] as usize..start[a as usize + 1] as usize];
+        list.partition_point(|&x| x <= b) - list.partition_point(|&x| x < b)
+    };
     let mut fixed = vec![false; n];
-    let mut i = 0;
-    while i < edges.len() {
-        let mut j = i + 1;
-        while j < edges.len() && edges[j] == edges[i] {
-            j += 1;
+    for a in 0..n as u32 {
+        let list = &adj[start[a as usize] as usize..start[a as usize + 1] as usize];
+        for (k, &b) in list.iter().enumerate() {
+            if (k == 0 || list[k - 1] != b) && uses(a, b) + uses(b, a) != 2 {
+                fixed[a as usize] = true;
+                fixed[b as usize] = true;
+            }
         }
-        if j - i != 2 {
-            fixed[(edges[i] >> 32) as usize] = true;
-            fixed[(edges[i] & 0xffff_ffff) as usize] = true;
-        }
-        i = j;
     }
     for (v, pr) in mesh.provenance.iter().enumerate() {
         if pr.curve == 0 && pr.step == 0 {
@@ -82,7 +86,6 @@ pub(crate) fn relax<T: Scalar, F: NormalField<T>>(
     let mut len = vec![0u32; n];
     for v in 0..n {
         let list = &mut adj[start[v] as usize..start[v + 1] as usize];
-        list.sort_unstable();
         let mut m = 0;
         for k in 0..list.len() {
             if k == 0 || list[k] != list[m - 1] {
@@ -117,15 +120,15 @@ pub(crate) fn relax<T: Scalar, F: NormalField<T>>(
             .collect();
         pos = keep_orientation(&mesh.triangles, &mesh.normals, pos, moved);
     }
-    mesh.vertices = pos.iter().map(|p| p.to_f64()).collect();
-    mesh.normals = pos
-        .iter()
-        .map(|p| {
-            trace::unit_normal(field, p)
-                .map(|(_, n, _)| n.to_f64())
-                .unwrap_or([0.0; 3])
-        })
-        .collect();
+    drop((adj, start, len, fixed));
+    // The neighbour lists are gone by now, and the vertices and normals are written in
+    // place: the flip pass below is the peak of the pipeline's memory.
+    for ((v, nrm), p) in mesh.vertices.iter_mut().zip(&mut mesh.normals).zip(&pos) {
+        *v = p.to_f64();
+        *nrm = trace::unit_normal(field, p)
+            .map(|(_, n, _)| n.to_f64())
+            .unwrap_or([0.0; 3]);
+    }
     let budget = 8 * mesh.triangles.len() + 64;
     flip_to_surface_delaunay(&mesh.vertices, &mesh.normals, &mut mesh.triangles, budget);
     pos
@@ -143,8 +146,8 @@ fn keep_orientation<T: Scalar>(
     old: Vec<Vec3<T>>,
     mut new: Vec<Vec3<T>>,
 ) -> Vec<Vec3<T>> {
-    let agreement = |pos: &[[f64; 3]], t: &[u32; 3]| {
-        let [a, b, c] = t.map(|i| pos[i as usize]);
+    let agreement = |pos: &[Vec3<T>], t: &[u32; 3]| {
+        let [a, b, c] = t.map(|i| pos[i as usize].to_f64());
         let u = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
         let w = [c[0] - a[0], c[1] - a[1], c[2] - a[2]];
         let f = [
@@ -167,20 +170,19 @@ fn keep_orientation<T: Scalar>(
             -1.0
         }
     };
-    let old_f: Vec<[f64; 3]> = old.iter().map(|p| p.to_f64()).collect();
-    let before: Vec<f64> = triangles.iter().map(|t| agreement(&old_f, t)).collect();
-    let mut new_f: Vec<[f64; 3]> = new.iter().map(|p| p.to_f64()).collect();
+    // Positions are read through `to_f64` rather than copied: free for `f64`, and no second
+    // copy of the mesh at the pipeline's peak memory.
+    let before: Vec<f64> = triangles.iter().map(|t| agreement(&old, t)).collect();
     // Each round reverts at least one moved vertex, so this ends within `new.len()` rounds.
     for _ in 0..=new.len() {
         let mut reverted = false;
         for (t, &b) in triangles.iter().zip(&before) {
             let limit = MIN_AGREEMENT.min(b);
-            if agreement(&new_f, t) < limit {
+            if agreement(&new, t) < limit {
                 for &i in t {
                     let i = i as usize;
-                    if new_f[i] != old_f[i] {
+                    if new[i].to_f64() != old[i].to_f64() {
                         new[i] = old[i].clone();
-                        new_f[i] = old_f[i];
                         reverted = true;
                     }
                 }
