@@ -109,7 +109,7 @@ fn next(h: u32) -> u32 {
 
 #[inline]
 fn prev(h: u32) -> u32 {
-    if h % 3 == 0 {
+    if h.is_multiple_of(3) {
         h + 2
     } else {
         h - 1
@@ -138,8 +138,8 @@ impl<'a> HalfEdges<'a> {
         let mut fill: Vec<u32> = start[..vertices].to_vec();
         let mut outgoing = vec![0u32; nh];
         for (t, tr) in tri.iter().enumerate() {
-            for k in 0..3 {
-                let v = tr[k] as usize;
+            for (k, &v) in tr.iter().enumerate() {
+                let v = v as usize;
                 outgoing[fill[v] as usize] = (3 * t + k) as u32;
                 fill[v] += 1;
             }
