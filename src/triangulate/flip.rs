@@ -57,6 +57,16 @@ fn angle_at(c: [f64; 3], a: [f64; 3], b: [f64; 3]) -> f64 {
     dot(cr, cr).sqrt().atan2(dot(u, v))
 }
 
+/// Whether the angles at `c` in (a, b, c) and at `d` in (b, a, d) add up to more than π,
+/// i.e. the edge `ab` is not Delaunay on the surface. Two acute angles cannot, which settles
+/// most edges without an arctangent.
+fn delaunay_violation(pa: [f64; 3], pb: [f64; 3], pc: [f64; 3], pd: [f64; 3]) -> bool {
+    if dot(sub(pa, pc), sub(pb, pc)) > 0.0 && dot(sub(pb, pd), sub(pa, pd)) > 0.0 {
+        return false;
+    }
+    angle_at(pc, pa, pb) + angle_at(pd, pb, pa) > std::f64::consts::PI + 1e-12
+}
+
 /// Unnormalised face normal.
 fn face_normal(p: &[[f64; 3]], t: [u32; 3]) -> [f64; 3] {
     let [a, b, c] = t.map(|i| p[i as usize]);
@@ -335,9 +345,6 @@ pub(crate) fn flip_to_surface_delaunay(
         let (t1, t2) = (h / 3, g / 3);
         let c = he.origin(prev(h));
         let d = he.origin(prev(g));
-        if c == d || he.adjacent(c, d) {
-            continue;
-        }
         let (pa, pb, pc, pd) = (
             points[a as usize],
             points[b as usize],
@@ -348,30 +355,35 @@ pub(crate) fn flip_to_surface_delaunay(
         let old2 = [b, a, d];
         let new1 = [a, d, c];
         let new2 = [d, b, c];
+        // The tests, cheapest and most often decisive first (almost every edge is already
+        // Delaunay and unfolded).
+        let folded =
+            || agreement(points, normals, old1) <= 0.0 || agreement(points, normals, old2) <= 0.0;
+        let was_folded = if delaunay_violation(pa, pb, pc, pd) {
+            None
+        } else if folded() {
+            Some(true)
+        } else {
+            continue;
+        };
+        if c == d || he.adjacent(c, d) {
+            continue;
+        }
         let new_ok =
             agreement(points, normals, new1) > 0.0 && agreement(points, normals, new2) > 0.0;
         if !new_ok {
             continue;
         }
-        // The flipped pair must not fold over the old one (the quad must be convex enough).
+        // The flipped pair must not fold over the old one (the quad must be convex enough)
+        // unless it undoes a fold.
         let old_sum = {
             let (f1, f2) = (face_normal(points, old1), face_normal(points, old2));
             [f1[0] + f2[0], f1[1] + f2[1], f1[2] + f2[2]]
         };
-        if dot(face_normal(points, new1), old_sum) <= 0.0
-            || dot(face_normal(points, new2), old_sum) <= 0.0
+        if (dot(face_normal(points, new1), old_sum) <= 0.0
+            || dot(face_normal(points, new2), old_sum) <= 0.0)
+            && !was_folded.unwrap_or_else(folded)
         {
-            let folded =
-                agreement(points, normals, old1) <= 0.0 || agreement(points, normals, old2) <= 0.0;
-            if !folded {
-                continue;
-            }
-        }
-        let folded =
-            agreement(points, normals, old1) <= 0.0 || agreement(points, normals, old2) <= 0.0;
-        let delaunay_violation =
-            angle_at(pc, pa, pb) + angle_at(pd, pb, pa) > std::f64::consts::PI + 1e-12;
-        if !(folded || delaunay_violation) {
             continue;
         }
         he.flip(t1, t2, [a, b, c, d]);

@@ -81,7 +81,7 @@ pub fn triangulate<T: Scalar>(
             .map(|&i| samples.normals[i as usize].to_f64())
             .collect();
         closing = close_hole(&front, &pos, &normals, &triangles);
-        if !stitches_cleanly(&triangles, &closing) {
+        if !stitches_cleanly(&triangles, &closing, n) {
             // Better an honest hole than a non-manifold mesh.
             closing.clear();
         }
@@ -411,9 +411,8 @@ fn close_hole(
     }
     // A diagonal of the hole that chart 1 already has as an edge would make the mesh
     // non-manifold: cut ears instead, which never repeat an edge.
-    let mut have: std::collections::HashSet<(u32, u32)> = existing
-        .iter()
-        .flat_map(|t| (0..3).map(move |k| (t[k], t[(k + 1) % 3])))
+    let mut have: EdgeSet = edges_among(existing, front, pos.len())
+        .into_iter()
         .collect();
     for t in &out {
         for k in 0..3 {
@@ -446,12 +445,36 @@ fn folds(triangles: &[[u32; 3]], pos: &[[f64; 3]], normals: &[[f64; 3]]) -> bool
 
 /// Whether `closing` meets `chart` edge to edge: every directed edge is used once, and every
 /// edge of the union by at most two triangles in opposite directions.
-fn stitches_cleanly(chart: &[[u32; 3]], closing: &[[u32; 3]]) -> bool {
-    let mut directed = std::collections::HashSet::with_capacity(3 * (chart.len() + closing.len()));
-    chart
+///
+/// Chart 1 alone is the inner faces of one planar triangulation, so only its edges between
+/// vertices of `closing` can clash: those and `closing`'s are checked.
+fn stitches_cleanly(chart: &[[u32; 3]], closing: &[[u32; 3]], vertices: usize) -> bool {
+    let used: Vec<u32> = closing.iter().flatten().copied().collect();
+    let mut directed: EdgeSet = edges_among(chart, &used, vertices).into_iter().collect();
+    closing
         .iter()
-        .chain(closing)
         .all(|t| (0..3).all(|k| t[k] != t[(k + 1) % 3] && directed.insert((t[k], t[(k + 1) % 3]))))
+}
+
+/// Directed-edge sets keyed by vertex pairs.
+type EdgeSet = std::collections::HashSet<(u32, u32), std::hash::BuildHasherDefault<EdgeHasher>>;
+
+/// The directed edges of `triangles` whose ends are both among `among` (indices below
+/// `vertices`; larger ones are ignored): what a hole's triangles, whose corners are all on
+/// its loop, can clash with, found without hashing every edge of the mesh.
+fn edges_among(triangles: &[[u32; 3]], among: &[u32], vertices: usize) -> Vec<(u32, u32)> {
+    let mut mark = vec![false; vertices];
+    for &v in among {
+        if let Some(m) = mark.get_mut(v as usize) {
+            *m = true;
+        }
+    }
+    let on = |v: u32| mark.get(v as usize).copied().unwrap_or(false);
+    triangles
+        .iter()
+        .flat_map(|t| (0..3).map(move |k| (t[k], t[(k + 1) % 3])))
+        .filter(|&(a, b)| on(a) && on(b))
+        .collect()
 }
 
 /// Closes a hole whose projection is not a simple polygon (e.g. the thin band an ellipsoid's
@@ -468,9 +491,9 @@ fn clip_ears(
         front.iter().copied().zip(normals.iter().copied()).collect();
     // Every edge the mesh already has: an ear must not repeat one (that would make it
     // non-manifold).
-    let mut edges: std::collections::HashSet<(u32, u32)> = existing
-        .iter()
-        .flat_map(|t| (0..3).map(move |k| (t[k].min(t[(k + 1) % 3]), t[k].max(t[(k + 1) % 3]))))
+    let mut edges: EdgeSet = edges_among(existing, front, pos.len())
+        .into_iter()
+        .map(|(a, b)| (a.min(b), a.max(b)))
         .collect();
     let mut out = Vec::with_capacity(ring.len());
     while ring.len() > 3 {
