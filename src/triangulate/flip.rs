@@ -155,56 +155,72 @@ impl<'a> HalfEdges<'a> {
             }
         }
         drop(fill);
-        let dest = |h: u32| tri[(h / 3) as usize][((h + 1) % 3) as usize];
-        let origin = |h: u32| tri[(h / 3) as usize][(h % 3) as usize];
+        // Around each vertex `o`, triangle `i` of its star has the half-edges `o → out_to[i]`
+        // and `in_from[i] → o`; the twin of `o → d` is the star's `d → o`. Matching within
+        // the star reads each triangle once, and walking it (`i` to the triangle whose
+        // outgoing edge leads to `in_from[i]`) checks that the star is one fan.
         let mut twin = vec![NONE; nh];
-        for h in 0..nh as u32 {
-            let (o, d) = (origin(h), dest(h));
-            let from_o = &outgoing[start[o as usize] as usize..start[o as usize + 1] as usize];
-            if from_o.iter().any(|&g| g != h && dest(g) == d) {
-                return None;
-            }
-            let mut found = NONE;
-            for &g in &outgoing[start[d as usize] as usize..start[d as usize + 1] as usize] {
-                if dest(g) == o {
-                    if found != NONE {
-                        return None;
-                    }
-                    found = g;
-                }
-            }
-            // A second half-edge `o → d` would also claim `found`.
-            if found != NONE {
-                if twin[found as usize] != NONE && twin[found as usize] != h {
-                    return None;
-                }
-                twin[h as usize] = found;
-                twin[found as usize] = h;
-            }
-        }
         let mut out = vec![NONE; vertices];
-        let mut he = HalfEdges {
-            tri,
-            twin,
-            out: Vec::new(),
-        };
-        for v in 0..vertices {
-            let list = &outgoing[start[v] as usize..start[v + 1] as usize];
-            let Some(&first) = list.first() else {
+        let (mut out_to, mut in_from, mut in_half) = (Vec::new(), Vec::new(), Vec::new());
+        for o in 0..vertices {
+            let star = &outgoing[start[o] as usize..start[o + 1] as usize];
+            let Some(&first) = star.first() else {
                 continue;
             };
-            out[v] = first;
-            let mut fan = 0usize;
-            he.for_each_around(first, |_| {
-                fan += 1;
-                false
-            });
-            if fan != list.len() {
+            out[o] = first;
+            out_to.clear();
+            in_from.clear();
+            in_half.clear();
+            for &h in star {
+                let t = &tri[(h / 3) as usize];
+                out_to.push(t[((h + 1) % 3) as usize]);
+                in_from.push(t[((h + 2) % 3) as usize]);
+                in_half.push(prev(h));
+            }
+            for (i, &d) in out_to.iter().enumerate() {
+                if d as usize == o || out_to[..i].contains(&d) || in_from[..i].contains(&in_from[i])
+                {
+                    return None;
+                }
+            }
+            let successor = |i: usize| out_to.iter().position(|&d| d == in_from[i]);
+            let predecessor = |i: usize| in_from.iter().position(|&x| x == out_to[i]);
+            for (i, &h) in star.iter().enumerate() {
+                if let Some(j) = predecessor(i) {
+                    twin[h as usize] = in_half[j];
+                }
+            }
+            // One fan: walking forward from triangle 0 (and backward, if the fan is open)
+            // visits every triangle of the star.
+            let mut seen = 1;
+            let mut i = 0;
+            let mut closed = false;
+            while let Some(j) = successor(i) {
+                if j == 0 {
+                    closed = true;
+                    break;
+                }
+                seen += 1;
+                if seen > star.len() {
+                    return None;
+                }
+                i = j;
+            }
+            if !closed {
+                let mut i = 0;
+                while let Some(j) = predecessor(i) {
+                    seen += 1;
+                    if seen > star.len() {
+                        return None;
+                    }
+                    i = j;
+                }
+            }
+            if seen != star.len() {
                 return None;
             }
         }
-        he.out = out;
-        Some(he)
+        Some(HalfEdges { tri, twin, out })
     }
 
     #[inline]
