@@ -30,7 +30,6 @@ type Cell = (i32, i32, i32);
 
 /// Point indices bucketed by cubic cells of side `cell`.
 pub(crate) struct Grid {
-    cell: f64,
     inv: f64,
     buckets: HashMap<Cell, Vec<u32>, BuildHasherDefault<CellHasher>>,
 }
@@ -38,7 +37,6 @@ pub(crate) struct Grid {
 impl Grid {
     pub(crate) fn new(cell: f64) -> Self {
         Grid {
-            cell,
             inv: 1.0 / cell,
             buckets: HashMap::default(),
         }
@@ -58,24 +56,28 @@ impl Grid {
     /// Calls `f` for every stored index whose cell meets the ball of `radius` around `p`
     /// (a superset of the points within `radius`), in a deterministic order.
     ///
-    /// When the cube of cells around `p` has more cells than the grid has buckets (a radius of
+    /// When the ball's bounding box meets more cells than the grid has buckets (a radius of
     /// many cells: an initial Δt far below the step lengths), every bucket is visited
     /// instead, which is cheaper and still a superset.
     pub(crate) fn for_each_near(&self, p: [f64; 3], radius: f64, mut f: impl FnMut(u32)) {
-        let r = (radius / self.cell).ceil().max(0.0);
-        let cube = (2.0 * r + 1.0).powi(3);
-        if cube.is_nan() || cube > self.buckets.len() as f64 {
+        // Only the cells the ball's bounding box meets: about 1.4³ of them for a radius of
+        // 0.7 cells, not the 27 of a cube of radius one cell.
+        let radius = radius.max(0.0);
+        let lo = self.key([p[0] - radius, p[1] - radius, p[2] - radius]);
+        let hi = self.key([p[0] + radius, p[1] + radius, p[2] + radius]);
+        let cells = (hi.0 as f64 - lo.0 as f64 + 1.0)
+            * (hi.1 as f64 - lo.1 as f64 + 1.0)
+            * (hi.2 as f64 - lo.2 as f64 + 1.0);
+        if radius.is_nan() || !(cells <= self.buckets.len() as f64) {
             for &i in self.buckets.values().flatten() {
                 f(i);
             }
             return;
         }
-        let r = r as i32;
-        let (cx, cy, cz) = self.key(p);
-        for dx in -r..=r {
-            for dy in -r..=r {
-                for dz in -r..=r {
-                    if let Some(bucket) = self.buckets.get(&(cx + dx, cy + dy, cz + dz)) {
+        for x in lo.0..=hi.0 {
+            for y in lo.1..=hi.1 {
+                for z in lo.2..=hi.2 {
+                    if let Some(bucket) = self.buckets.get(&(x, y, z)) {
                         for &i in bucket {
                             f(i);
                         }
