@@ -68,7 +68,7 @@ impl Grid {
         let cells = (hi.0 as f64 - lo.0 as f64 + 1.0)
             * (hi.1 as f64 - lo.1 as f64 + 1.0)
             * (hi.2 as f64 - lo.2 as f64 + 1.0);
-        if radius.is_nan() || !(cells <= self.buckets.len() as f64) {
+        if radius.is_nan() || cells > self.buckets.len() as f64 {
             for &i in self.buckets.values().flatten() {
                 f(i);
             }
