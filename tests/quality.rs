@@ -105,3 +105,28 @@ fn fig6_reports_the_recovery_error_beside_the_integrability_defect() {
     assert!(q.recovery.relative_error.is_some());
     assert!(q.drift.is_none(), "no potential, no drift");
 }
+
+#[test]
+fn paper_mode_curves_meet_on_the_far_side_of_the_ellipsoid_despite_their_drift() {
+    // Explicit Euler carries curves off the ellipsoid by amounts that differ from curve to
+    // curve; without allowing for that along the normal they pass over each other, never
+    // collide, and keep spawning curves (4,596 of them before the drift-aware test).
+    let (inv, params) = ellipsoid();
+    let paper = MeshParams {
+        mode: Mode::Paper,
+        ..params
+    };
+    let run = liemesh::run(&LieField::<f64>::new(&inv), &paper).unwrap();
+    let collisions = run
+        .samples
+        .curves
+        .iter()
+        .filter(|c| c.end == liemesh::sample::CurveEnd::Collision)
+        .count();
+    assert!(
+        run.samples.curves.len() < 3_000,
+        "{}",
+        run.samples.curves.len()
+    );
+    assert!(collisions > 10, "{collisions} collisions");
+}

@@ -11,7 +11,7 @@
 mod grid;
 
 use crate::error::MeshError;
-use crate::params::{MeshParams, Method};
+use crate::params::{MeshParams, Method, Mode};
 use crate::scalar::{Scalar, Vec3};
 use crate::trace::{self, StepConfig, StepLimit};
 use crate::triangulate::Provenance;
@@ -121,6 +121,9 @@ struct Live<T> {
     left: u32,
     right: u32,
     active: bool,
+    /// Paper mode: how far explicit Euler has carried the curve off the surface, estimated
+    /// as `Σ Δt·α/2` (a chord of length Δt across a turn of α leaves the arc by about that).
+    drift: f64,
 }
 
 /// Samples the surface of `field` from `params.p0` (paper Steps 2–7).
@@ -181,7 +184,12 @@ pub fn sample<T: Scalar, F: NormalField<T>>(
         live: Vec::new(),
         heap: BinaryHeap::new(),
         grid: Grid::new(params.dt.max(1e-300)),
+        drift: Vec::new(),
+        max_drift: 0.0,
     };
+    if params.mode == Mode::Paper {
+        s.drift.push(0.0);
+    }
     s.grid.insert(params.p0, 0);
     let n = thetas.len() as u32;
     for (j, &theta) in thetas.iter().enumerate() {
@@ -203,6 +211,7 @@ pub fn sample<T: Scalar, F: NormalField<T>>(
             left: (j + n - 1) % n,
             right: (j + 1) % n,
             active: true,
+            drift: 0.0,
         });
         s.heap.push(Reverse((s.order_key(0.0), j)));
     }
@@ -233,6 +242,10 @@ struct Sampler<'a, T, F> {
     live: Vec<Live<T>>,
     heap: BinaryHeap<Reverse<(u64, u32)>>,
     grid: Grid,
+    /// Paper mode only (empty otherwise): each point's curve drift when it was laid down.
+    drift: Vec<f64>,
+    /// The largest entry of `drift`.
+    max_drift: f64,
 }
 
 fn dist(a: [f64; 3], b: [f64; 3]) -> f64 {
@@ -313,7 +326,9 @@ impl<T: Scalar, F: NormalField<T>> Sampler<'_, T, F> {
         }
         let theta = self.out.curves[ci].theta;
         let chart_q = [s_new * theta.cos(), s_new * theta.sin()];
-        if self.params.terminal.close && self.collides(q, chart_q, len) {
+        let drift = live.drift + 0.5 * len * step.alpha_predicted;
+        let normal = (!self.drift.is_empty()).then(|| step.normal.to_f64());
+        if self.params.terminal.close && self.collides(q, chart_q, len, normal, drift) {
             return Some(CurveEnd::Collision);
         }
         let proposed = self.params.method == Method::Proposed;
@@ -346,7 +361,12 @@ impl<T: Scalar, F: NormalField<T>> Sampler<'_, T, F> {
         self.pos.push(q);
         self.chart.push(self.out.chart(index as usize));
         self.grid.insert(q, index);
+        if !self.drift.is_empty() {
+            self.drift.push(drift);
+            self.max_drift = self.max_drift.max(drift);
+        }
         let live = &mut self.live[ci];
+        live.drift = drift;
         live.p = step.point;
         live.carry = step.carry;
         live.dt = step.dt;
@@ -382,15 +402,41 @@ impl<T: Scalar, F: NormalField<T>> Sampler<'_, T, F> {
 
     /// The closure test: a point nearer than `COLLISION_RADIUS` steps whose chart position is
     /// much farther away than its distance in space, i.e. the surface came back on itself.
-    fn collides(&self, q: [f64; 3], chart_q: [f64; 2], len: f64) -> bool {
+    ///
+    /// In paper mode (`normal` given: the unit normal near `q`), explicit Euler has carried
+    /// both curves off the surface, by different amounts on a surface that is not a sphere, so
+    /// that curves meeting on the far side pass over each other: there the distance along
+    /// the normal may also be as large as both curves' drift estimates together.
+    fn collides(
+        &self,
+        q: [f64; 3],
+        chart_q: [f64; 2],
+        len: f64,
+        normal: Option<[f64; 3]>,
+        drift_q: f64,
+    ) -> bool {
         let radius = COLLISION_RADIUS * len;
+        let reach = match normal {
+            Some(_) => radius + drift_q + self.max_drift,
+            None => radius,
+        };
         let mut hit = false;
-        self.grid.for_each_near(q, radius, |j| {
+        self.grid.for_each_near(q, reach, |j| {
             if hit {
                 return;
             }
-            let d = dist(q, self.pos[j as usize]);
-            if d < radius {
+            let pj = self.pos[j as usize];
+            let d = dist(q, pj);
+            let near = match normal {
+                None => d < radius,
+                Some(n) => {
+                    let e = sub(q, pj);
+                    let along = dot(e, n);
+                    let across = (d * d - along * along).max(0.0).sqrt();
+                    across < radius && along.abs() < radius + drift_q + self.drift[j as usize]
+                }
+            };
+            if near {
                 let cj = self.chart[j as usize];
                 let dc = ((cj[0] - chart_q[0]).powi(2) + (cj[1] - chart_q[1]).powi(2)).sqrt();
                 if dc > 2.0 * d + len {
@@ -493,7 +539,15 @@ impl<T: Scalar, F: NormalField<T>> Sampler<'_, T, F> {
             return;
         }
         let chart = [s * theta.cos(), s * theta.sin()];
-        if self.params.terminal.close && self.collides(start_f, chart, len) {
+        let drift = 0.5 * (self.live[c as usize].drift + self.live[k as usize].drift);
+        let normal = if self.drift.is_empty() {
+            None
+        } else {
+            trace::unit_normal(self.field, &start)
+                .ok()
+                .map(|(_, n, _)| n.to_f64())
+        };
+        if self.params.terminal.close && self.collides(start_f, chart, len, normal, drift) {
             return;
         }
         let carry = (&self.live[c as usize].carry + &self.live[k as usize].carry)
@@ -519,6 +573,9 @@ impl<T: Scalar, F: NormalField<T>> Sampler<'_, T, F> {
         self.pos.push(start_f);
         self.chart.push(self.out.chart(index as usize));
         self.grid.insert(start_f, index);
+        if !self.drift.is_empty() {
+            self.drift.push(drift);
+        }
         let (left, right) = if k_is_right { (c, k) } else { (k, c) };
         self.live.push(Live {
             p: start,
@@ -528,6 +585,7 @@ impl<T: Scalar, F: NormalField<T>> Sampler<'_, T, F> {
             left,
             right,
             active: true,
+            drift,
         });
         self.live[left as usize].right = id;
         self.live[right as usize].left = id;
