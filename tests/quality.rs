@@ -179,3 +179,53 @@ fn fig6_face_normal_error_grows_with_distance_from_p0_as_the_field_twists_not_fr
         assert!(spread < 2.0 * beta_max, "error {error}°, spread {spread}°");
     }
 }
+
+/// The ellipsoid meshed from `p0` with the β band scaled by `scale`.
+fn ellipsoid_from(p0: [f64; 3], w00: [f64; 3], scale: f64) -> (usize, QualityReport) {
+    let (inv, params) = ellipsoid();
+    let params = MeshParams {
+        p0,
+        w00,
+        beta_min: params.beta_min * scale,
+        beta_max: params.beta_max * scale,
+        ..params
+    };
+    measure(&inv, &params)
+}
+
+#[test]
+fn the_ellipsoid_closes_watertight_from_the_tip_of_its_long_axis() {
+    // The curves from (1, 0, 0) cross a caustic near (−1, 0, 0), where chart 1 folds and the
+    // hole is a thin twisted band: the folded triangles are filled together with the hole.
+    let (_, q) = ellipsoid_from([1.0, 0.0, 0.0], [0.0, 1.0, 0.0], 1.0);
+    assert!(
+        q.topology.closed && q.topology.euler_characteristic == 2,
+        "{:?}",
+        q.topology
+    );
+    assert_eq!(q.topology.orientation_flips, 0);
+    assert!(q.drift.unwrap().max <= 1e-9, "{:?}", q.drift);
+    assert!(q.shape.min_angle >= 10.0, "{}", q.shape.min_angle);
+    assert!(
+        q.face_normal_error_max <= 15.0,
+        "{}",
+        q.face_normal_error_max
+    );
+}
+
+#[test]
+fn the_ellipsoid_closes_watertight_with_the_beta_band_halved() {
+    let (triangles, q) = ellipsoid_from([0.0, 0.0, 0.25], [1.0, 0.0, 0.0], 0.5);
+    assert!(triangles > 30_000, "{triangles}");
+    assert!(
+        q.topology.closed && q.topology.euler_characteristic == 2,
+        "{:?}",
+        q.topology
+    );
+    assert!(q.shape.min_angle >= 20.0, "{}", q.shape.min_angle);
+    assert!(
+        q.face_normal_error_max <= 4.0,
+        "{}",
+        q.face_normal_error_max
+    );
+}

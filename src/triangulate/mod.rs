@@ -15,6 +15,7 @@
 mod flip;
 mod mesh;
 mod relax;
+mod reopen;
 
 pub(crate) use flip::EdgeHasher;
 pub(crate) use relax::relax;
@@ -73,9 +74,10 @@ pub fn triangulate<T: Scalar>(
     let front = front_polygon(samples, &chart);
     let pos: Vec<[f64; 3]> = samples.points.iter().map(|p| p.to_f64()).collect();
 
-    let triangles = chart_triangles(&chart, &front)?;
+    let mut triangles = chart_triangles(&chart, &front)?;
+    let closable = close && samples.front_closed() && front.len() >= 3;
     let mut closing = Vec::new();
-    if close && samples.front_closed() && front.len() >= 3 {
+    if closable {
         let normals: Vec<[f64; 3]> = front
             .iter()
             .map(|&i| samples.normals[i as usize].to_f64())
@@ -88,8 +90,8 @@ pub fn triangulate<T: Scalar>(
     }
 
     let normals: Vec<[f64; 3]> = samples.normals.iter().map(|v| v.to_f64()).collect();
-    let finish = |closing: &[[u32; 3]]| {
-        let mut all = triangles.clone();
+    let finish = |triangles: &[[u32; 3]], closing: &[[u32; 3]]| {
+        let mut all = triangles.to_vec();
         all.extend_from_slice(closing);
         if improve {
             let budget = 8 * all.len() + 64;
@@ -97,12 +99,27 @@ pub fn triangulate<T: Scalar>(
         }
         all
     };
-    let mut all = finish(&closing);
+    let mut all = finish(&triangles, &closing);
     // Closing triangles across a thin, twisted hole can face against the field, and flips
     // cannot always turn them round: then the hole stays open rather than folded.
     if !closing.is_empty() && folds(&all, &pos, &normals) {
         closing.clear();
-        all = finish(&closing);
+        all = finish(&triangles, &closing);
+    }
+    // A hole that would not close because chart 1 folds next to it (curves crossing a
+    // caustic) gets a second try: the folded triangles and their neighbours are filled
+    // together with the hole.
+    if closable && closing.is_empty() {
+        if let Some((kept, fill)) = reopen::reclose(&front, &triangles, &pos, &normals) {
+            if stitches_cleanly(&kept, &fill, n) {
+                let candidate = finish(&kept, &fill);
+                if !folds(&candidate, &pos, &normals) {
+                    triangles = kept;
+                    closing = fill;
+                    all = candidate;
+                }
+            }
+        }
     }
     // Three points on a line in space (curves that ran straight along a degenerate field)
     // make a triangle of no area and no normal, however good it looks in the chart.
@@ -344,25 +361,9 @@ fn close_hole(
     existing: &[[u32; 3]],
 ) -> Vec<[u32; 3]> {
     let m = front.len();
-    let mut mean = [0.0; 3];
-    for n in normals {
-        for k in 0..3 {
-            mean[k] += n[k];
-        }
-    }
-    let len = (mean[0].powi(2) + mean[1].powi(2) + mean[2].powi(2)).sqrt();
-    if len.is_nan() || len <= 0.0 {
+    let Some([f1, f2, _]) = frame_around(normals.iter().copied()) else {
         return Vec::new();
-    }
-    let nm = [mean[0] / len, mean[1] / len, mean[2] / len];
-    // Right-handed frame (f1, f2, nm).
-    let helper = if nm[0].abs() < 0.9 {
-        [1.0, 0.0, 0.0]
-    } else {
-        [0.0, 1.0, 0.0]
     };
-    let f1 = normalize3(cross3(helper, nm));
-    let f2 = cross3(nm, f1);
     let proj: Vec<[f64; 2]> = front
         .iter()
         .map(|&i| {
@@ -425,6 +426,29 @@ fn close_hole(
         }
     }
     out
+}
+
+/// A right-handed frame `(f1, f2, n)` whose `n` is the mean of `normals`, or `None` when they
+/// cancel out (or are not finite).
+fn frame_around(normals: impl Iterator<Item = [f64; 3]>) -> Option<[[f64; 3]; 3]> {
+    let mut mean = [0.0; 3];
+    for n in normals {
+        for k in 0..3 {
+            mean[k] += n[k];
+        }
+    }
+    let len = dot3(mean, mean).sqrt();
+    if len.is_nan() || len <= 0.0 {
+        return None;
+    }
+    let nm = mean.map(|x| x / len);
+    let helper = if nm[0].abs() < 0.9 {
+        [1.0, 0.0, 0.0]
+    } else {
+        [0.0, 1.0, 0.0]
+    };
+    let f1 = normalize3(cross3(helper, nm));
+    Some([f1, cross3(nm, f1), nm])
 }
 
 /// Whether any of `triangles` faces against the field normal at its corners (a closing

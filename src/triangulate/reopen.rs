@@ -1,0 +1,363 @@
+//! Re-closing a surface whose chart folds next to the hole.
+//!
+//! Geodesic polar coordinates stop being a chart where the curves from `p0` cross a caustic
+//! (on an ellipsoid started away from its shortest axis, near the far end). There chart 1's
+//! triangles fold over in space and the hole left between the curves is a thin twisted band
+//! that no planar projection fills. The points themselves are fine, only their connectivity
+//! is wrong: the folded triangles next to the hole, plus a ring or two of their neighbours,
+//! are taken out, and the larger hole is filled with a constrained Delaunay triangulation of
+//! its loop *and the points inside it*, projected across the region's mean normal.
+
+use super::{
+    cross3, dot3, frame_around, point_in_polygon, signed_area, simple_polygon, sub3, ChartVertex,
+    EdgeSet,
+};
+use spade::{ConstrainedDelaunayTriangulation, Point2, Triangulation as _};
+use std::collections::HashMap;
+
+/// Cosine between a chart-1 face and the field normal at its corners below which the face
+/// counts as folded by the chart (30°: the default mode's faces stay within a few degrees).
+const FOLDED: f64 = 0.866;
+
+/// Rings of neighbours tried around the folded triangles before giving up.
+const MAX_RINGS: usize = 4;
+
+/// Fill attempts (each after growing the region by a ring or by the stars of pinch points).
+const MAX_ATTEMPTS: usize = 24;
+
+/// The chart-1 triangles kept, and the triangles that fill the rest.
+pub(super) type Reclosed = (Vec<[u32; 3]>, Vec<[u32; 3]>);
+
+/// Chart-1 `triangles` minus a region around the hole bounded by `front` (the folded
+/// triangles connected to it, or else the triangles along it, grown ring by ring), and the
+/// triangles that fill the region and the hole together; `None` when no region within
+/// [`MAX_RINGS`] rings and [`MAX_ATTEMPTS`] attempts has a single simple loop whose flat image
+/// can be filled.
+pub(super) fn reclose(
+    front: &[u32],
+    triangles: &[[u32; 3]],
+    pos: &[[f64; 3]],
+    normals: &[[f64; 3]],
+) -> Option<Reclosed> {
+    let n = pos.len();
+    if triangles.iter().flatten().any(|&v| v as usize >= n) {
+        return None;
+    }
+    // Triangles at each vertex (CSR).
+    let mut start = vec![0u32; n + 1];
+    for t in triangles {
+        for &v in t {
+            start[v as usize + 1] += 1;
+        }
+    }
+    for v in 0..n {
+        start[v + 1] += start[v];
+    }
+    let mut fill = start[..n].to_vec();
+    let mut at = vec![0u32; start[n] as usize];
+    for (i, t) in triangles.iter().enumerate() {
+        for &v in t {
+            at[fill[v as usize] as usize] = i as u32;
+            fill[v as usize] += 1;
+        }
+    }
+    let star = |v: u32| &at[start[v as usize] as usize..start[v as usize + 1] as usize];
+    let folded = |t: &[u32; 3]| agreement(pos, normals, t) < FOLDED;
+
+    // Folded triangles connected to the hole through folded triangles (sharing vertices).
+    let mut in_region = vec![false; triangles.len()];
+    let mut queue: Vec<u32> = Vec::new();
+    for &v in front {
+        for &t in star(v) {
+            if !in_region[t as usize] && folded(&triangles[t as usize]) {
+                in_region[t as usize] = true;
+                queue.push(t);
+            }
+        }
+    }
+    if queue.is_empty() {
+        // Nothing folded: a thin hole between curves that stopped short; give the fill the
+        // triangles along the hole to work with.
+        for &v in front {
+            for &t in star(v) {
+                if !in_region[t as usize] {
+                    in_region[t as usize] = true;
+                    queue.push(t);
+                }
+            }
+        }
+    }
+    let mut region = Vec::new();
+    while let Some(t) = queue.pop() {
+        region.push(t);
+        for &v in &triangles[t as usize] {
+            for &u in star(v) {
+                if !in_region[u as usize] && folded(&triangles[u as usize]) {
+                    in_region[u as usize] = true;
+                    queue.push(u);
+                }
+            }
+        }
+    }
+    let absorb = |vertices: &[u32], region: &mut Vec<u32>, in_region: &mut [bool]| {
+        for &v in vertices {
+            for &u in star(v) {
+                if !in_region[u as usize] {
+                    in_region[u as usize] = true;
+                    region.push(u);
+                }
+            }
+        }
+    };
+    let mut rings = 0;
+    for _ in 0..MAX_ATTEMPTS {
+        match fill_region(triangles, &in_region, &region, pos, normals) {
+            Ok(closing) => {
+                let kept = triangles
+                    .iter()
+                    .zip(&in_region)
+                    .filter(|(_, &r)| !r)
+                    .map(|(t, _)| *t)
+                    .collect();
+                return Some((kept, closing));
+            }
+            // The kept triangles touch each other at these vertices across the region:
+            // take their stars in too.
+            Err(Retry::Pinched(vertices)) => absorb(&vertices, &mut region, &mut in_region),
+            Err(Retry::Grow) => {
+                if rings == MAX_RINGS {
+                    return None;
+                }
+                rings += 1;
+                let vertices: Vec<u32> =
+                    region.iter().flat_map(|&t| triangles[t as usize]).collect();
+                absorb(&vertices, &mut region, &mut in_region);
+            }
+        }
+    }
+    None
+}
+
+/// Why a region could not be filled, and what to try next.
+enum Retry {
+    /// The kept triangles touch at these vertices (the loop would pass them twice), or these
+    /// vertices bound islands of kept triangles inside the region: take their stars in.
+    Pinched(Vec<u32>),
+    /// The loop is not simple in projection, or the fill failed: a larger region may do.
+    Grow,
+}
+
+/// Fills the hole plus the region's triangles, or `None` when their boundary is not one
+/// simple loop or its projection cannot be filled.
+fn fill_region(
+    triangles: &[[u32; 3]],
+    in_region: &[bool],
+    region: &[u32],
+    pos: &[[f64; 3]],
+    normals: &[[f64; 3]],
+) -> Result<Vec<[u32; 3]>, Retry> {
+    // The boundary of the kept triangles, each edge directed with them on its left (as chart 1
+    // lies to the left of the front). All of it, not only the front's and the region's edges:
+    // chart 1 may split a front edge at a point on it.
+    let kept: Vec<[u32; 3]> = triangles
+        .iter()
+        .zip(in_region)
+        .filter(|(_, &r)| !r)
+        .map(|(t, _)| *t)
+        .collect();
+    let kept_edges: EdgeSet = kept
+        .iter()
+        .flat_map(|t| (0..3).map(move |k| (t[k], t[(k + 1) % 3])))
+        .collect();
+    let mut next: HashMap<u32, u32> = HashMap::new();
+    let mut pinched = Vec::new();
+    for &(a, b) in &kept_edges {
+        if !kept_edges.contains(&(b, a)) && next.insert(a, b).is_some() {
+            pinched.push(a);
+        }
+    }
+    if !pinched.is_empty() {
+        pinched.sort_unstable();
+        return Err(Retry::Pinched(pinched));
+    }
+    // Split the boundary into loops; all but the longest surround islands of kept triangles
+    // inside the region (or the smaller side of a region that cuts the surface in two):
+    // those are taken in too.
+    let mut starts: Vec<u32> = next.keys().copied().collect();
+    starts.sort_unstable();
+    let mut seen: HashMap<u32, usize> = HashMap::with_capacity(next.len());
+    let mut loops: Vec<Vec<u32>> = Vec::new();
+    for &s in &starts {
+        if seen.contains_key(&s) {
+            continue;
+        }
+        let mut lp = vec![s];
+        seen.insert(s, loops.len());
+        let mut v = *next.get(&s).ok_or(Retry::Grow)?;
+        while v != s {
+            if seen.insert(v, loops.len()).is_some() {
+                return Err(Retry::Grow);
+            }
+            lp.push(v);
+            v = *next.get(&v).ok_or(Retry::Grow)?;
+        }
+        loops.push(lp);
+    }
+    let longest = (0..loops.len())
+        .max_by_key(|&i| (loops[i].len(), std::cmp::Reverse(i)))
+        .ok_or(Retry::Grow)?;
+    if loops.len() > 1 {
+        let others = loops
+            .iter()
+            .enumerate()
+            .filter(|&(i, _)| i != longest)
+            .flat_map(|(_, l)| l.iter().copied())
+            .collect();
+        return Err(Retry::Pinched(others));
+    }
+    let lp = loops.swap_remove(longest);
+    if lp.len() < 3 {
+        return Err(Retry::Grow);
+    }
+    let mut on_loop = vec![false; pos.len()];
+    for &v in &lp {
+        on_loop[v as usize] = true;
+    }
+    // Points inside: the region's vertices off the loop, used by no kept triangle.
+    let mut used_by_kept = vec![false; pos.len()];
+    for t in &kept {
+        for &v in t {
+            used_by_kept[v as usize] = true;
+        }
+    }
+    let mut inside: Vec<u32> = region
+        .iter()
+        .flat_map(|&t| triangles[t as usize])
+        .filter(|&v| !on_loop[v as usize])
+        .collect();
+    inside.sort_unstable();
+    inside.dedup();
+    if inside.iter().any(|&v| used_by_kept[v as usize]) {
+        return Err(Retry::Grow);
+    }
+    let closing = fill_polygon(&lp, &inside, pos, normals, Projection::Plane)
+        .or_else(|| fill_polygon(&lp, &inside, pos, normals, Projection::Gauss))
+        .ok_or(Retry::Grow)?;
+    // No closing edge may repeat a kept one (that would make an edge non-manifold).
+    let mut have = kept_edges;
+    for t in &closing {
+        for k in 0..3 {
+            let (a, b) = (t[k], t[(k + 1) % 3]);
+            if have.contains(&(a, b)) || !have.insert((a, b)) {
+                return Err(Retry::Grow);
+            }
+        }
+    }
+    Ok(closing)
+}
+
+/// How the region is laid flat for its triangulation.
+#[derive(Clone, Copy)]
+enum Projection {
+    /// Orthogonally onto the plane across the region's mean normal.
+    Plane,
+    /// Through the Gauss map: each point goes to its unit normal, projected stereographically
+    /// from the pole opposite the mean normal. One-to-one and orientation-preserving wherever
+    /// the surface is strictly convex, however far the normals turn (the pointed end of an
+    /// ellipsoid), where the plane folds.
+    Gauss,
+}
+
+/// Constrained Delaunay triangulation of the loop `lp` (kept triangles to its left) and the
+/// points `inside` that fall inside it, laid flat by `chart` around their mean normal; `None`
+/// unless the flat loop is simple and runs clockwise seen from outside, and every point keeps
+/// its own vertex.
+fn fill_polygon(
+    lp: &[u32],
+    inside: &[u32],
+    pos: &[[f64; 3]],
+    normals: &[[f64; 3]],
+    chart: Projection,
+) -> Option<Vec<[u32; 3]>> {
+    let all: Vec<u32> = lp.iter().chain(inside).copied().collect();
+    let [f1, f2, nm] = frame_around(all.iter().map(|&v| normals[v as usize]))?;
+    // For the plane every normal must face the plane's side, or the projection folds the
+    // region over itself; the Gauss map only needs to stay off the opposite pole.
+    let limit = match chart {
+        Projection::Plane => 0.0,
+        Projection::Gauss => -0.9,
+    };
+    if all.iter().any(|&v| dot3(normals[v as usize], nm) <= limit) {
+        return None;
+    }
+    let proj: Vec<[f64; 2]> = all
+        .iter()
+        .map(|&v| match chart {
+            Projection::Plane => {
+                let p = pos[v as usize];
+                [dot3(p, f1), dot3(p, f2)]
+            }
+            Projection::Gauss => {
+                let u = normals[v as usize];
+                let k = 1.0 / (1.0 + dot3(u, nm));
+                [k * dot3(u, f1), k * dot3(u, f2)]
+            }
+        })
+        .collect();
+    let m = lp.len();
+    let polygon = &proj[..m];
+    if !simple_polygon(polygon) || signed_area(polygon) >= 0.0 {
+        return None;
+    }
+    // Points of the region that fall outside the loop (where chart 1 had laid the region
+    // over its neighbours) are left out: the fill covers the loop either way, and the mesh
+    // simply does not use them.
+    let vertices: Vec<ChartVertex> = proj
+        .iter()
+        .enumerate()
+        .filter(|&(i, &c)| i < m || point_in_polygon(polygon, c))
+        .map(|(i, c)| ChartVertex {
+            position: Point2::new(c[0], c[1]),
+            index: i as u32,
+        })
+        .collect();
+    let expected = vertices.len();
+    let edges: Vec<[usize; 2]> = (0..m).map(|i| [i, (i + 1) % m]).collect();
+    let mut conflict = false;
+    let cdt =
+        ConstrainedDelaunayTriangulation::<ChartVertex>::try_bulk_load_cdt(vertices, edges, |_| {
+            conflict = true
+        })
+        .ok()?;
+    if conflict || cdt.num_vertices() != expected {
+        return None;
+    }
+    let mut out = Vec::new();
+    for face in cdt.inner_faces() {
+        let [a, b, c] = face.vertices();
+        let (pa, pb, pc) = (a.position(), b.position(), c.position());
+        let centroid = [(pa.x + pb.x + pc.x) / 3.0, (pa.y + pb.y + pc.y) / 3.0];
+        if point_in_polygon(polygon, centroid) {
+            out.push([a, b, c].map(|h| all[h.data().index as usize]));
+        }
+    }
+    Some(out)
+}
+
+/// Cosine between the face `t` and the sum of the field normals at its corners.
+fn agreement(pos: &[[f64; 3]], normals: &[[f64; 3]], t: &[u32; 3]) -> f64 {
+    let [a, b, c] = t.map(|i| pos[i as usize]);
+    let f = cross3(sub3(b, a), sub3(c, a));
+    let mut g = [0.0; 3];
+    for &i in t {
+        for k in 0..3 {
+            g[k] += normals[i as usize][k];
+        }
+    }
+    let d = (dot3(f, f) * dot3(g, g)).sqrt();
+    if d > 0.0 {
+        dot3(f, g) / d
+    } else {
+        -1.0
+    }
+}
