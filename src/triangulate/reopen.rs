@@ -13,7 +13,7 @@ use super::{
     EdgeSet,
 };
 use spade::{ConstrainedDelaunayTriangulation, Point2, Triangulation as _};
-use std::collections::HashMap;
+use std::collections::{HashMap, HashSet};
 
 /// Cosine between a chart-1 face and the field normal at its corners below which the face
 /// counts as folded by the chart (30°: the default mode's faces stay within a few degrees).
@@ -43,25 +43,16 @@ pub(super) fn reclose(
     if triangles.iter().flatten().any(|&v| v as usize >= n) {
         return None;
     }
-    // Triangles at each vertex (CSR).
-    let mut start = vec![0u32; n + 1];
-    for t in triangles {
-        for &v in t {
-            start[v as usize + 1] += 1;
-        }
-    }
-    for v in 0..n {
-        start[v + 1] += start[v];
-    }
-    let mut fill = start[..n].to_vec();
-    let mut at = vec![0u32; start[n] as usize];
-    for (i, t) in triangles.iter().enumerate() {
-        for &v in t {
-            at[fill[v as usize] as usize] = i as u32;
-            fill[v as usize] += 1;
-        }
-    }
-    let star = |v: u32| &at[start[v as usize] as usize..start[v as usize + 1] as usize];
+    let stars = Stars::new(triangles, n);
+    let star = |v: u32| stars.at(v);
+    // Chart 1's own boundary (the front, with any front edge split at a point on it), as
+    // (edge, triangle) pairs: found once, kept apart from the region's edges below.
+    let boundary: Vec<(u32, u32, u32)> = triangles
+        .iter()
+        .enumerate()
+        .flat_map(|(i, t)| (0..3).map(move |k| (t[k], t[(k + 1) % 3], i as u32)))
+        .filter(|&(a, b, _)| stars.holding(triangles, b, a).is_none())
+        .collect();
     let folded = |t: &[u32; 3]| agreement(pos, normals, t) < FOLDED;
 
     // Folded triangles connected to the hole through folded triangles (sharing vertices).
@@ -111,7 +102,9 @@ pub(super) fn reclose(
     };
     let mut rings = 0;
     for _ in 0..MAX_ATTEMPTS {
-        match fill_region(triangles, &in_region, &region, pos, normals) {
+        match fill_region(
+            triangles, &stars, &boundary, &in_region, &region, pos, normals,
+        ) {
             Ok(closing) => {
                 let kept = triangles
                     .iter()
@@ -138,6 +131,47 @@ pub(super) fn reclose(
     None
 }
 
+/// The triangles at each vertex (CSR).
+struct Stars {
+    start: Vec<u32>,
+    list: Vec<u32>,
+}
+
+impl Stars {
+    fn new(triangles: &[[u32; 3]], n: usize) -> Self {
+        let mut start = vec![0u32; n + 1];
+        for t in triangles {
+            for &v in t {
+                start[v as usize + 1] += 1;
+            }
+        }
+        for v in 0..n {
+            start[v + 1] += start[v];
+        }
+        let mut fill = start[..n].to_vec();
+        let mut list = vec![0u32; start[n] as usize];
+        for (i, t) in triangles.iter().enumerate() {
+            for &v in t {
+                list[fill[v as usize] as usize] = i as u32;
+                fill[v as usize] += 1;
+            }
+        }
+        Stars { start, list }
+    }
+
+    fn at(&self, v: u32) -> &[u32] {
+        &self.list[self.start[v as usize] as usize..self.start[v as usize + 1] as usize]
+    }
+
+    /// The triangle with the directed edge `a → b`, if any.
+    fn holding(&self, triangles: &[[u32; 3]], a: u32, b: u32) -> Option<u32> {
+        self.at(a).iter().copied().find(|&t| {
+            let t = triangles[t as usize];
+            (0..3).any(|k| t[k] == a && t[(k + 1) % 3] == b)
+        })
+    }
+}
+
 /// Why a region could not be filled, and what to try next.
 enum Retry {
     /// The kept triangles touch at these vertices (the loop would pass them twice), or these
@@ -151,29 +185,36 @@ enum Retry {
 /// simple loop or its projection cannot be filled.
 fn fill_region(
     triangles: &[[u32; 3]],
+    stars: &Stars,
+    boundary: &[(u32, u32, u32)],
     in_region: &[bool],
     region: &[u32],
     pos: &[[f64; 3]],
     normals: &[[f64; 3]],
 ) -> Result<Vec<[u32; 3]>, Retry> {
     // The boundary of the kept triangles, each edge directed with them on its left (as chart 1
-    // lies to the left of the front). All of it, not only the front's and the region's edges:
-    // chart 1 may split a front edge at a point on it.
-    let kept: Vec<[u32; 3]> = triangles
-        .iter()
-        .zip(in_region)
-        .filter(|(_, &r)| !r)
-        .map(|(t, _)| *t)
-        .collect();
-    let kept_edges: EdgeSet = kept
-        .iter()
-        .flat_map(|t| (0..3).map(move |k| (t[k], t[(k + 1) % 3])))
-        .collect();
+    // lies to the left of the front): chart 1's boundary edges that are kept, and the region's
+    // edges seen from a kept triangle.
+    let kept = |t: u32| !in_region[t as usize];
     let mut next: HashMap<u32, u32> = HashMap::new();
     let mut pinched = Vec::new();
-    for &(a, b) in &kept_edges {
-        if !kept_edges.contains(&(b, a)) && next.insert(a, b).is_some() {
+    let mut add = |a: u32, b: u32| {
+        if next.insert(a, b).is_some() {
             pinched.push(a);
+        }
+    };
+    for &(a, b, t) in boundary {
+        if kept(t) {
+            add(a, b);
+        }
+    }
+    for &t in region {
+        let t = triangles[t as usize];
+        for k in 0..3 {
+            let (a, b) = (t[k], t[(k + 1) % 3]);
+            if stars.holding(triangles, b, a).is_some_and(kept) {
+                add(b, a);
+            }
         }
     }
     if !pinched.is_empty() {
@@ -219,32 +260,34 @@ fn fill_region(
     if lp.len() < 3 {
         return Err(Retry::Grow);
     }
-    let mut on_loop = vec![false; pos.len()];
-    for &v in &lp {
-        on_loop[v as usize] = true;
-    }
+    let on_loop: HashSet<u32> = lp.iter().copied().collect();
     // Points inside: the region's vertices off the loop, used by no kept triangle.
-    let mut used_by_kept = vec![false; pos.len()];
-    for t in &kept {
-        for &v in t {
-            used_by_kept[v as usize] = true;
-        }
-    }
     let mut inside: Vec<u32> = region
         .iter()
         .flat_map(|&t| triangles[t as usize])
-        .filter(|&v| !on_loop[v as usize])
+        .filter(|v| !on_loop.contains(v))
         .collect();
     inside.sort_unstable();
     inside.dedup();
-    if inside.iter().any(|&v| used_by_kept[v as usize]) {
+    if inside.iter().any(|&v| stars.at(v).iter().any(|&t| kept(t))) {
         return Err(Retry::Grow);
     }
     let closing = fill_polygon(&lp, &inside, pos, normals, Projection::Plane)
         .or_else(|| fill_polygon(&lp, &inside, pos, normals, Projection::Gauss))
         .ok_or(Retry::Grow)?;
-    // No closing edge may repeat a kept one (that would make an edge non-manifold).
-    let mut have = kept_edges;
+    // No closing edge may repeat a kept one (that would make an edge non-manifold); the
+    // closing's corners are all on the loop or inside, so only kept edges along the loop
+    // can clash.
+    let mut have: EdgeSet = lp
+        .iter()
+        .flat_map(|&v| stars.at(v))
+        .filter(|&&t| kept(t))
+        .flat_map(|&t| {
+            let t = triangles[t as usize];
+            (0..3).map(move |k| (t[k], t[(k + 1) % 3]))
+        })
+        .filter(|(a, b)| on_loop.contains(a) && on_loop.contains(b))
+        .collect();
     for t in &closing {
         for k in 0..3 {
             let (a, b) = (t[k], t[(k + 1) % 3]);
