@@ -20,10 +20,10 @@ use std::collections::{HashMap, HashSet};
 const FOLDED: f64 = 0.866;
 
 /// Rings of neighbours tried around the folded triangles before giving up.
-const MAX_RINGS: usize = 4;
+const MAX_RINGS: usize = 16;
 
 /// Fill attempts (each after growing the region by a ring or by the stars of pinch points).
-const MAX_ATTEMPTS: usize = 24;
+const MAX_ATTEMPTS: usize = 128;
 
 /// The chart-1 triangles kept, and the triangles that fill the rest.
 pub(super) type Reclosed = (Vec<[u32; 3]>, Vec<[u32; 3]>);
