@@ -7,7 +7,7 @@ use serde::{Deserialize, Serialize};
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "lowercase", tag = "kind")]
 pub enum Method {
-    /// The previous method (paper refs [5][6]): `curves` curves at uniform angles, no insertion.
+    /// The previous method (paper refs \[5\]\[6\]): `curves` curves at uniform angles, no insertion.
     Previous {
         /// Number of curves leaving `p0`.
         curves: usize,
