@@ -214,6 +214,25 @@ fn the_ellipsoid_closes_watertight_from_the_tip_of_its_long_axis() {
 }
 
 #[test]
+fn the_ellipsoid_closes_watertight_from_its_middle_axis() {
+    // From (0, 1/2, 0) the folded region on the far side spans more than a hemisphere of
+    // normals: only the Gauss map lays it flat.
+    let (_, q) = ellipsoid_from([0.0, 0.5, 0.0], [1.0, 0.0, 0.0], 1.0);
+    assert!(
+        q.topology.closed && q.topology.euler_characteristic == 2,
+        "{:?}",
+        q.topology
+    );
+    assert_eq!(q.topology.orientation_flips, 0);
+    assert!(q.shape.min_angle >= 20.0, "{}", q.shape.min_angle);
+    assert!(
+        q.face_normal_error_max <= 20.0,
+        "{}",
+        q.face_normal_error_max
+    );
+}
+
+#[test]
 fn the_ellipsoid_closes_watertight_with_the_beta_band_halved() {
     let (triangles, q) = ellipsoid_from([0.0, 0.0, 0.25], [1.0, 0.0, 0.0], 0.5);
     assert!(triangles > 30_000, "{triangles}");
@@ -235,7 +254,7 @@ fn most_ellipsoids_close_from_any_starting_point() {
     // Axis-aligned ellipsoids with semi-axis ratios up to 4, each meshed from a random point
     // of it: from most starting points the curves cross a caustic on the far side, and the
     // closing has to fill the folded band. 16 of these 60 closed before folded triangles
-    // were filled together with the hole (56 now, every one with angles of at least 15° and
+    // were filled together with the hole (57 now, every one with angles of at least 15° and
     // face normals within 15° of the field); open meshes are reported, and valid.
     let mut state = 12345_u64;
     let mut uniform = || {
@@ -278,5 +297,5 @@ fn most_ellipsoids_close_from_any_starting_point() {
         }
     }
     assert_eq!(meshed, 60);
-    assert!(closed >= 50, "{closed} of 60 closed");
+    assert!(closed >= 52, "{closed} of 60 closed");
 }

@@ -325,10 +325,11 @@ fn fill_polygon(
     let all: Vec<u32> = lp.iter().chain(inside).copied().collect();
     let [f1, f2, nm] = frame_around(all.iter().map(|&v| normals[v as usize]))?;
     // For the plane every normal must face the plane's side, or the projection folds the
-    // region over itself; the Gauss map only needs to stay off the opposite pole.
+    // region over itself; the Gauss map only needs to stay off the opposite pole (near it the
+    // image runs off to infinity).
     let limit = match chart {
         Projection::Plane => 0.0,
-        Projection::Gauss => -0.9,
+        Projection::Gauss => -0.99,
     };
     if all.iter().any(|&v| dot3(normals[v as usize], nm) <= limit) {
         return None;
