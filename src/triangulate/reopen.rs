@@ -25,6 +25,9 @@ const MAX_RINGS: usize = 16;
 /// Fill attempts (each after growing the region by a ring or by the stars of pinch points).
 const MAX_ATTEMPTS: usize = 128;
 
+/// Region triangles all attempts together may handle beyond twice the mesh's triangles.
+const WORK_FLOOR: usize = 200_000;
+
 /// The chart-1 triangles kept, and the triangles that fill the rest.
 pub(super) type Reclosed = (Vec<[u32; 3]>, Vec<[u32; 3]>);
 
@@ -101,7 +104,16 @@ pub(super) fn reclose(
         }
     };
     let mut rings = 0;
+    // Each attempt costs about the region's size: the attempts together may cost twice the
+    // mesh (plus a floor for small meshes), so that a hole that will not close does not make
+    // a large mesh slower by more than a constant factor.
+    let budget = 2 * triangles.len() + WORK_FLOOR;
+    let mut work = 0;
     for _ in 0..MAX_ATTEMPTS {
+        work += region.len();
+        if work > budget {
+            return None;
+        }
         match fill_region(
             triangles, &stars, &boundary, &in_region, &region, pos, normals,
         ) {
