@@ -233,6 +233,25 @@ fn the_ellipsoid_closes_watertight_from_its_middle_axis() {
 }
 
 #[test]
+fn the_ellipsoid_closes_watertight_at_a_quarter_of_the_beta_band() {
+    // At 1°–2° the band's two sides overlap in a neck that uniform growth does not remove:
+    // the region is widened where its loop crosses itself.
+    let (triangles, q) = ellipsoid_from([0.0, 0.0, 0.25], [1.0, 0.0, 0.0], 0.25);
+    assert!(triangles > 150_000, "{triangles}");
+    assert!(
+        q.topology.closed && q.topology.euler_characteristic == 2,
+        "{:?}",
+        q.topology
+    );
+    assert!(q.shape.min_angle >= 15.0, "{}", q.shape.min_angle);
+    assert!(
+        q.face_normal_error_max <= 2.0,
+        "{}",
+        q.face_normal_error_max
+    );
+}
+
+#[test]
 fn the_ellipsoid_closes_watertight_with_the_beta_band_halved() {
     let (triangles, q) = ellipsoid_from([0.0, 0.0, 0.25], [1.0, 0.0, 0.0], 0.5);
     assert!(triangles > 30_000, "{triangles}");
@@ -254,8 +273,8 @@ fn most_ellipsoids_close_from_any_starting_point() {
     // Axis-aligned ellipsoids with semi-axis ratios up to 4, each meshed from a random point
     // of it: from most starting points the curves cross a caustic on the far side, and the
     // closing has to fill the folded band. 16 of these 60 closed before folded triangles
-    // were filled together with the hole (57 now, every one with angles of at least 15° and
-    // face normals within 15° of the field); open meshes are reported, and valid.
+    // were filled together with the hole (all 60 now, every one with angles of at least 15°
+    // and face normals within 15° of the field); open meshes are reported, and valid.
     let mut state = 12345_u64;
     let mut uniform = || {
         state ^= state << 13;
@@ -297,5 +316,5 @@ fn most_ellipsoids_close_from_any_starting_point() {
         }
     }
     assert_eq!(meshed, 60);
-    assert!(closed >= 52, "{closed} of 60 closed");
+    assert!(closed >= 57, "{closed} of 60 closed");
 }

@@ -90,8 +90,8 @@ pub fn triangulate<T: Scalar>(
     }
 
     let normals: Vec<[f64; 3]> = samples.normals.iter().map(|v| v.to_f64()).collect();
-    let finish = |triangles: &[[u32; 3]], closing: &[[u32; 3]]| {
-        let mut all = triangles.to_vec();
+    // Chart 1 (or what is kept of it) and a closing, flipped to surface Delaunay in place.
+    let finish = |mut all: Vec<[u32; 3]>, closing: &[[u32; 3]]| {
         all.extend_from_slice(closing);
         if improve {
             let budget = 8 * all.len() + 64;
@@ -99,28 +99,36 @@ pub fn triangulate<T: Scalar>(
         }
         all
     };
-    let mut all = finish(&triangles, &closing);
-    // Closing triangles across a thin, twisted hole can face against the field, and flips
-    // cannot always turn them round: then the hole stays open rather than folded.
-    if !closing.is_empty() && folds(&all, &pos, &normals) {
-        closing.clear();
-        all = finish(&triangles, &closing);
+    // The finished triangles, once some closing (or none) is settled on.
+    let mut finished = None;
+    if !closing.is_empty() {
+        let all = finish(triangles.clone(), &closing);
+        // Closing triangles across a thin, twisted hole can face against the field, and flips
+        // cannot always turn them round: then the hole stays open rather than folded.
+        if folds(&all, &pos, &normals) {
+            closing.clear();
+        } else {
+            finished = Some(all);
+        }
     }
     // A hole that would not close because chart 1 folds next to it (curves crossing a
     // caustic) gets a second try: the folded triangles and their neighbours are filled
     // together with the hole.
     if closable && closing.is_empty() {
-        if let Some((kept, fill)) = reopen::reclose(&front, &triangles, &pos, &normals) {
-            if stitches_cleanly(&kept, &fill, n) {
-                let candidate = finish(&kept, &fill);
-                if !folds(&candidate, &pos, &normals) {
-                    triangles = kept;
-                    closing = fill;
-                    all = candidate;
-                }
+        let accept = |kept: Vec<[u32; 3]>, fill: &[[u32; 3]]| {
+            if !stitches_cleanly(&kept, fill, n) {
+                return None;
             }
+            let all = finish(kept, fill);
+            (!folds(&all, &pos, &normals)).then_some(all)
+        };
+        if let Some(r) = reopen::reclose(&front, &triangles, &pos, &normals, accept) {
+            triangles = r.kept;
+            closing = r.closing;
+            finished = Some(r.finished);
         }
     }
+    let mut all = finished.unwrap_or_else(|| finish(triangles.clone(), &closing));
     // Three points on a line in space (curves that ran straight along a degenerate field)
     // make a triangle of no area and no normal, however good it looks in the chart.
     all.retain(|t| {

@@ -28,19 +28,29 @@ const MAX_ATTEMPTS: usize = 128;
 /// Region triangles all attempts together may handle beyond twice the mesh's triangles.
 const WORK_FLOOR: usize = 200_000;
 
-/// The chart-1 triangles kept, and the triangles that fill the rest.
-pub(super) type Reclosed = (Vec<[u32; 3]>, Vec<[u32; 3]>);
+/// A successful reclosing.
+pub(super) struct Reclosed {
+    /// The chart-1 triangles kept.
+    pub kept: Vec<[u32; 3]>,
+    /// The triangles that fill the rest.
+    pub closing: Vec<[u32; 3]>,
+    /// What `accept` made of the two.
+    pub finished: Vec<[u32; 3]>,
+}
 
 /// Chart-1 `triangles` minus a region around the hole bounded by `front` (the folded
 /// triangles connected to it, or else the triangles along it, grown ring by ring), and the
-/// triangles that fill the region and the hole together; `None` when no region within
-/// [`MAX_RINGS`] rings and [`MAX_ATTEMPTS`] attempts has a single simple loop whose flat image
-/// can be filled.
+/// triangles that fill the region and the hole together, as soon as `accept` takes them (given
+/// the kept triangles, to finish in place, and the fill, it returns the finished mesh, or
+/// `None` if the two do not stitch into a valid one); `None`
+/// when no region within [`MAX_RINGS`] rings, [`MAX_ATTEMPTS`] attempts and the work budget
+/// has a single simple loop whose flat image can be filled acceptably.
 pub(super) fn reclose(
     front: &[u32],
     triangles: &[[u32; 3]],
     pos: &[[f64; 3]],
     normals: &[[f64; 3]],
+    accept: impl Fn(Vec<[u32; 3]>, &[[u32; 3]]) -> Option<Vec<[u32; 3]>>,
 ) -> Option<Reclosed> {
     let n = pos.len();
     if triangles.iter().flatten().any(|&v| v as usize >= n) {
@@ -118,13 +128,30 @@ pub(super) fn reclose(
             triangles, &stars, &boundary, &in_region, &region, pos, normals,
         ) {
             Ok(closing) => {
-                let kept = triangles
-                    .iter()
-                    .zip(&in_region)
-                    .filter(|(_, &r)| !r)
-                    .map(|(t, _)| *t)
-                    .collect();
-                return Some((kept, closing));
+                let kept = || {
+                    triangles
+                        .iter()
+                        .zip(&in_region)
+                        .filter(|(_, &r)| !r)
+                        .map(|(t, _)| *t)
+                };
+                // Judging the whole mesh costs about its size.
+                work += triangles.len();
+                if let Some(finished) = accept(kept().collect(), &closing) {
+                    return Some(Reclosed {
+                        kept: kept().collect(),
+                        closing,
+                        finished,
+                    });
+                }
+                // The fill folds somewhere once stitched in: a larger region may not.
+                if rings == MAX_RINGS {
+                    return None;
+                }
+                rings += 1;
+                let vertices: Vec<u32> =
+                    region.iter().flat_map(|&t| triangles[t as usize]).collect();
+                absorb(&vertices, &mut region, &mut in_region);
             }
             // The kept triangles touch each other at these vertices across the region:
             // take their stars in too.
@@ -284,9 +311,18 @@ fn fill_region(
     if inside.iter().any(|&v| stars.at(v).iter().any(|&t| kept(t))) {
         return Err(Retry::Grow);
     }
-    let closing = fill_polygon(&lp, &inside, pos, normals, Projection::Plane)
+    let Some(closing) = fill_polygon(&lp, &inside, pos, normals, Projection::Plane)
         .or_else(|| fill_polygon(&lp, &inside, pos, normals, Projection::Gauss))
-        .ok_or(Retry::Grow)?;
+    else {
+        // Where the loop crosses itself (a neck of the region between two overlapping sheets
+        // of chart 1), widen the region there; elsewhere grow it all round.
+        let crossing = crossings(&lp, pos, normals);
+        return Err(if crossing.is_empty() {
+            Retry::Grow
+        } else {
+            Retry::Pinched(crossing)
+        });
+    };
     // No closing edge may repeat a kept one (that would make an edge non-manifold); the
     // closing's corners are all on the loop or inside, so only kept edges along the loop
     // can clash.
@@ -323,6 +359,73 @@ enum Projection {
     Gauss,
 }
 
+/// The points `all` laid flat by `chart` around their mean normal, or `None` where the chart
+/// does not hold (a normal facing away from the plane, or too near the Gauss map's pole).
+fn flatten(
+    all: &[u32],
+    pos: &[[f64; 3]],
+    normals: &[[f64; 3]],
+    chart: Projection,
+) -> Option<Vec<[f64; 2]>> {
+    let [f1, f2, nm] = frame_around(all.iter().map(|&v| normals[v as usize]))?;
+    // For the plane every normal must face the plane's side, or the projection folds the
+    // region over itself; the Gauss map only needs to stay off the opposite pole (near it the
+    // image runs off to infinity).
+    let limit = match chart {
+        Projection::Plane => 0.0,
+        Projection::Gauss => -0.99,
+    };
+    if all.iter().any(|&v| dot3(normals[v as usize], nm) <= limit) {
+        return None;
+    }
+    Some(
+        all.iter()
+            .map(|&v| match chart {
+                Projection::Plane => {
+                    let p = pos[v as usize];
+                    [dot3(p, f1), dot3(p, f2)]
+                }
+                Projection::Gauss => {
+                    let u = normals[v as usize];
+                    let k = 1.0 / (1.0 + dot3(u, nm));
+                    [k * dot3(u, f1), k * dot3(u, f2)]
+                }
+            })
+            .collect(),
+    )
+}
+
+/// The loop's vertices at the ends of edges that cross another edge of the loop in the Gauss
+/// map's image (empty if none do, or the loop is too long to check).
+fn crossings(lp: &[u32], pos: &[[f64; 3]], normals: &[[f64; 3]]) -> Vec<u32> {
+    let m = lp.len();
+    let Some(p) = flatten(lp, pos, normals, Projection::Gauss) else {
+        return Vec::new();
+    };
+    if m > 4096 {
+        return Vec::new();
+    }
+    let cross = |a: [f64; 2], b: [f64; 2], c: [f64; 2]| {
+        (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0])
+    };
+    let mut out = Vec::new();
+    for i in 0..m {
+        for j in i + 2..m {
+            if i == 0 && j == m - 1 {
+                continue;
+            }
+            let (a, b) = (p[i], p[(i + 1) % m]);
+            let (c, d) = (p[j], p[(j + 1) % m]);
+            if cross(a, b, c) * cross(a, b, d) <= 0.0 && cross(c, d, a) * cross(c, d, b) <= 0.0 {
+                out.extend([lp[i], lp[(i + 1) % m], lp[j], lp[(j + 1) % m]]);
+            }
+        }
+    }
+    out.sort_unstable();
+    out.dedup();
+    out
+}
+
 /// Constrained Delaunay triangulation of the loop `lp` (kept triangles to its left) and the
 /// points `inside` that fall inside it, laid flat by `chart` around their mean normal; `None`
 /// unless the flat loop is simple and runs clockwise seen from outside, and every point keeps
@@ -335,31 +438,7 @@ fn fill_polygon(
     chart: Projection,
 ) -> Option<Vec<[u32; 3]>> {
     let all: Vec<u32> = lp.iter().chain(inside).copied().collect();
-    let [f1, f2, nm] = frame_around(all.iter().map(|&v| normals[v as usize]))?;
-    // For the plane every normal must face the plane's side, or the projection folds the
-    // region over itself; the Gauss map only needs to stay off the opposite pole (near it the
-    // image runs off to infinity).
-    let limit = match chart {
-        Projection::Plane => 0.0,
-        Projection::Gauss => -0.99,
-    };
-    if all.iter().any(|&v| dot3(normals[v as usize], nm) <= limit) {
-        return None;
-    }
-    let proj: Vec<[f64; 2]> = all
-        .iter()
-        .map(|&v| match chart {
-            Projection::Plane => {
-                let p = pos[v as usize];
-                [dot3(p, f1), dot3(p, f2)]
-            }
-            Projection::Gauss => {
-                let u = normals[v as usize];
-                let k = 1.0 / (1.0 + dot3(u, nm));
-                [k * dot3(u, f1), k * dot3(u, f2)]
-            }
-        })
-        .collect();
+    let proj = flatten(&all, pos, normals, chart)?;
     let m = lp.len();
     let polygon = &proj[..m];
     if !simple_polygon(polygon) || signed_area(polygon) >= 0.0 {
