@@ -124,7 +124,7 @@ pub(super) fn reclose(
         if work > budget {
             return None;
         }
-        match fill_region(
+        let grow = match fill_region(
             triangles, &stars, &boundary, &in_region, &region, pos, normals,
         ) {
             Ok(closing) => {
@@ -145,26 +145,23 @@ pub(super) fn reclose(
                     });
                 }
                 // The fill folds somewhere once stitched in: a larger region may not.
-                if rings == MAX_RINGS {
-                    return None;
-                }
-                rings += 1;
-                let vertices: Vec<u32> =
-                    region.iter().flat_map(|&t| triangles[t as usize]).collect();
-                absorb(&vertices, &mut region, &mut in_region);
+                true
             }
             // The kept triangles touch each other at these vertices across the region:
             // take their stars in too.
-            Err(Retry::Pinched(vertices)) => absorb(&vertices, &mut region, &mut in_region),
-            Err(Retry::Grow) => {
-                if rings == MAX_RINGS {
-                    return None;
-                }
-                rings += 1;
-                let vertices: Vec<u32> =
-                    region.iter().flat_map(|&t| triangles[t as usize]).collect();
+            Err(Retry::Pinched(vertices)) => {
                 absorb(&vertices, &mut region, &mut in_region);
+                false
             }
+            Err(Retry::Grow) => true,
+        };
+        if grow {
+            if rings == MAX_RINGS {
+                return None;
+            }
+            rings += 1;
+            let vertices: Vec<u32> = region.iter().flat_map(|&t| triangles[t as usize]).collect();
+            absorb(&vertices, &mut region, &mut in_region);
         }
     }
     None
