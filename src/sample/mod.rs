@@ -416,8 +416,11 @@ impl<T: Scalar, F: NormalField<T>> Sampler<'_, T, F> {
         drift_q: f64,
     ) -> bool {
         let radius = COLLISION_RADIUS * len;
+        // Points about as far off as this one (curves that meet have come a similar way),
+        // within a few steps: a search out to the largest drift anywhere would visit most of
+        // the mesh at every step.
         let reach = match normal {
-            Some(_) => radius + drift_q + self.max_drift,
+            Some(_) => radius + (2.0 * drift_q).min(4.0 * len),
             None => radius,
         };
         let mut hit = false;
