@@ -22,6 +22,7 @@ use crate::model::{Invariant, InvariantError, LieField};
 use crate::preset::Preset;
 use crate::quality::Topology;
 use crate::sample::{Curve, CurveEnd, Samples, StepRecord};
+use crate::scalar::f64x3::{cross as cross3, sub as sub3};
 use crate::scalar::Vec3;
 use crate::trace::StepLimit;
 use crate::triangulate::{ChartTriangulation, Mesh, Provenance};
@@ -732,18 +733,6 @@ pub fn check_chart_delaunay(chart: &ChartTriangulation) -> Result<usize, Violati
         }
     }
     Ok(checked)
-}
-
-fn sub3(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
-}
-
-fn cross3(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
 }
 
 // ---------------------------------------------------------------------------------------------

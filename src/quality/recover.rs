@@ -8,6 +8,7 @@
 //! scaled to the reference by least squares and decomposed as `A = diag(λ) Rx(θ) Ry(φ) Rz(ψ)`.
 
 use crate::model::Invariant;
+use crate::scalar::f64x3::{cross, dot, normalize, sub};
 use crate::triangulate::Mesh;
 use nalgebra::{DMatrix, Matrix3};
 use serde::{Deserialize, Serialize};
@@ -41,16 +42,9 @@ pub fn mesh_normals(mesh: &Mesh) -> Vec<[f64; 3]> {
             let p = mesh.vertices[v];
             let a = mesh.vertices[t[(k + 1) % 3] as usize];
             let b = mesh.vertices[t[(k + 2) % 3] as usize];
-            let u = [a[0] - p[0], a[1] - p[1], a[2] - p[2]];
-            let w = [b[0] - p[0], b[1] - p[1], b[2] - p[2]];
-            let n = [
-                u[1] * w[2] - u[2] * w[1],
-                u[2] * w[0] - u[0] * w[2],
-                u[0] * w[1] - u[1] * w[0],
-            ];
-            let uu = u[0] * u[0] + u[1] * u[1] + u[2] * u[2];
-            let ww = w[0] * w[0] + w[1] * w[1] + w[2] * w[2];
-            let weight = uu * ww;
+            let (u, w) = (sub(a, p), sub(b, p));
+            let n = cross(u, w);
+            let weight = dot(u, u) * dot(w, w);
             if weight > 0.0 {
                 for c in 0..3 {
                     acc[v][c] += n[c] / weight;
@@ -173,27 +167,6 @@ pub fn jet_normals(mesh: &Mesh) -> Vec<[f64; 3]> {
         .collect()
 }
 
-fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
-
-fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
-}
-
-fn normalize(a: [f64; 3]) -> [f64; 3] {
-    let l = dot(a, a).sqrt();
-    if l > 0.0 {
-        a.map(|x| x / l)
-    } else {
-        [0.0; 3]
-    }
-}
-
 /// Fits the field to `mesh`; `hamiltonian` adds the 9 entries of `B`. With a `reference`
 /// invariant, the fit is scaled to it and its relative error reported.
 pub fn recover(mesh: &Mesh, hamiltonian: bool, reference: Option<&Invariant>) -> Recovery {
@@ -208,23 +181,6 @@ pub fn recover(mesh: &Mesh, hamiltonian: bool, reference: Option<&Invariant>) ->
         .map(|&i| mesh.vertices[i].iter().fold(0.0_f64, |m, x| m.max(x.abs())))
         .fold(0.0_f64, f64::max)
         .max(1e-300);
-    // Each vertex stands for a third of its faces' area, so that the fit measures the
-    // surface, not the sampling density.
-    let mut area = vec![0.0; mesh.vertices.len()];
-    for t in &mesh.triangles {
-        let [a, b, c] = t.map(|i| mesh.vertices[i as usize]);
-        let u = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
-        let w = [c[0] - a[0], c[1] - a[1], c[2] - a[2]];
-        let n = [
-            u[1] * w[2] - u[2] * w[1],
-            u[2] * w[0] - u[0] * w[2],
-            u[0] * w[1] - u[1] * w[0],
-        ];
-        let third = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt() / 6.0;
-        for &i in t {
-            area[i as usize] += third;
-        }
-    }
     let points: Vec<([f64; 3], [f64; 3])> = used
         .iter()
         .map(|&i| {
@@ -262,10 +218,7 @@ pub fn recover(mesh: &Mesh, hamiltonian: bool, reference: Option<&Invariant>) ->
             .expect("at least 9 unknowns");
         (eig.eigenvectors.column(imin).clone_owned(), lmin)
     };
-    let total_area: f64 = used.iter().map(|&i| area[i]).sum::<f64>().max(1e-300);
-    let _ = total_area;
-    let area_weights: Vec<f64> = used.iter().map(|_| 1.0).collect();
-    let (first, _) = solve(&area_weights);
+    let (first, _) = solve(&vec![1.0; used.len()]);
     // Second pass: divide each equation by |v(p)| of the first fit, so that every vertex
     // contributes the sine of its normal's angle error, whatever the field's magnitude.
     let field_norm = |row: usize| {
@@ -285,14 +238,14 @@ pub fn recover(mesh: &Mesh, hamiltonian: bool, reference: Option<&Invariant>) ->
         .map(|row| {
             let f = field_norm(row);
             if f > 0.0 {
-                area_weights[row] / f
+                1.0 / f
             } else {
                 0.0
             }
         })
         .collect();
     let (x, lmin) = solve(&weights);
-    // RMS angle residual (the weights sum to one over the area).
+    // The smallest eigenvalue is the reweighted residual's sum of squares at unit norm.
     let residual = lmin.max(0.0).sqrt();
     let mut a = [[0.0; 3]; 3];
     let mut b = [[0.0; 3]; 3];

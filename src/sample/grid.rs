@@ -1,37 +1,15 @@
 //! A uniform hash grid over points: O(1) neighbourhood queries for the gap and
 //! closure tests of the sampler.
 
+use crate::scalar::f64x3::FastHash;
 use std::collections::HashMap;
-use std::hash::{BuildHasherDefault, Hasher};
-
-/// A small multiplicative hasher: cell keys are three small integers, SipHash is overkill.
-#[derive(Default)]
-pub(crate) struct CellHasher(u64);
-
-impl Hasher for CellHasher {
-    #[inline]
-    fn finish(&self) -> u64 {
-        self.0
-    }
-    #[inline]
-    fn write(&mut self, bytes: &[u8]) {
-        for &b in bytes {
-            self.0 = (self.0.rotate_left(5) ^ b as u64).wrapping_mul(0x51_7c_c1_b7_27_22_0a_95);
-        }
-    }
-    #[inline]
-    fn write_i32(&mut self, i: i32) {
-        self.0 =
-            (self.0.rotate_left(5) ^ (i as u32 as u64)).wrapping_mul(0x51_7c_c1_b7_27_22_0a_95);
-    }
-}
 
 type Cell = (i32, i32, i32);
 
 /// Point indices bucketed by cubic cells of side `cell`.
 pub(crate) struct Grid {
     inv: f64,
-    buckets: HashMap<Cell, Vec<u32>, BuildHasherDefault<CellHasher>>,
+    buckets: HashMap<Cell, Vec<u32>, FastHash>,
 }
 
 impl Grid {

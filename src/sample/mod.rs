@@ -12,6 +12,7 @@ mod grid;
 
 use crate::error::MeshError;
 use crate::params::{MeshParams, Method, Mode};
+use crate::scalar::f64x3::{dist, dot, sub};
 use crate::scalar::{Scalar, Vec3};
 use crate::trace::{self, StepConfig, StepLimit};
 use crate::triangulate::Provenance;
@@ -246,18 +247,6 @@ struct Sampler<'a, T, F> {
     drift: Vec<f64>,
     /// The largest entry of `drift`.
     max_drift: f64,
-}
-
-fn dist(a: [f64; 3], b: [f64; 3]) -> f64 {
-    ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2) + (a[2] - b[2]).powi(2)).sqrt()
-}
-
-fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
-}
-
-fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 }
 
 impl<T: Scalar, F: NormalField<T>> Sampler<'_, T, F> {

@@ -18,6 +18,7 @@
 //! ```
 
 mod dual;
+pub(crate) mod f64x3;
 #[cfg(feature = "mpfr")]
 mod mpfr;
 mod vec3;

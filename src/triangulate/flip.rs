@@ -7,48 +7,7 @@
 //! when it keeps the mesh a consistently oriented 2-manifold whose faces agree with the field
 //! normal; flips that undo a fold (a face against the field normal) come first.
 
-use std::hash::Hasher;
-
-/// A multiply-mix hasher for packed edge keys (SipHash dominated the profile of the edge
-/// tables that use it).
-#[derive(Default)]
-pub(crate) struct EdgeHasher(u64);
-
-impl Hasher for EdgeHasher {
-    #[inline]
-    fn finish(&self) -> u64 {
-        self.0
-    }
-    #[inline]
-    fn write(&mut self, bytes: &[u8]) {
-        for &b in bytes {
-            self.write_u64(self.0 ^ b as u64);
-        }
-    }
-    #[inline]
-    fn write_u32(&mut self, k: u32) {
-        self.write_u64(k as u64);
-    }
-    #[inline]
-    fn write_u64(&mut self, k: u64) {
-        let h = (self.0 ^ k).wrapping_mul(0x9E37_79B9_7F4A_7C15);
-        self.0 = h ^ (h >> 29);
-    }
-}
-
-fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
-}
-fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
-fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
-}
+use crate::scalar::f64x3::{cross, dot, sub};
 
 /// Angle at `c` in triangle (a, b, c).
 fn angle_at(c: [f64; 3], a: [f64; 3], b: [f64; 3]) -> f64 {
@@ -84,8 +43,14 @@ fn field_normal(n: &[[f64; 3]], t: [u32; 3]) -> [f64; 3] {
 }
 
 /// Cosine of the angle between a face and the field normal at its corners.
-fn agreement(p: &[[f64; 3]], n: &[[f64; 3]], t: [u32; 3]) -> f64 {
-    let f = face_normal(p, t);
+pub(super) fn agreement(p: &[[f64; 3]], n: &[[f64; 3]], t: [u32; 3]) -> f64 {
+    agreement_at(t.map(|i| p[i as usize]), n, t)
+}
+
+/// [`agreement`] for a face whose corners `t` sit at `corners`.
+pub(super) fn agreement_at(corners: [[f64; 3]; 3], n: &[[f64; 3]], t: [u32; 3]) -> f64 {
+    let [a, b, c] = corners;
+    let f = cross(sub(b, a), sub(c, a));
     let g = field_normal(n, t);
     let d = (dot(f, f) * dot(g, g)).sqrt();
     if d > 0.0 {

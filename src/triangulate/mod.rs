@@ -17,13 +17,15 @@ mod mesh;
 mod relax;
 mod reopen;
 
-pub(crate) use flip::EdgeHasher;
 pub(crate) use relax::relax;
 
 pub use mesh::{Mesh, Provenance};
 
 use crate::error::MeshError;
 use crate::sample::{CurveEnd, Samples};
+use crate::scalar::f64x3::{
+    cross as cross3, dot as dot3, normalize as normalize3, sub as sub3, FastHash,
+};
 use crate::scalar::Scalar;
 use spade::{ConstrainedDelaunayTriangulation, HasPosition, Point2, Triangulation as _};
 
@@ -489,7 +491,7 @@ fn stitches_cleanly(chart: &[[u32; 3]], closing: &[[u32; 3]], vertices: usize) -
 }
 
 /// Directed-edge sets keyed by vertex pairs.
-type EdgeSet = std::collections::HashSet<(u32, u32), std::hash::BuildHasherDefault<EdgeHasher>>;
+type EdgeSet = std::collections::HashSet<(u32, u32), FastHash>;
 
 /// The directed edges of `triangles` whose ends are both among `among` (indices below
 /// `vertices`; larger ones are ignored): what a hole's triangles, whose corners are all on
@@ -555,25 +557,6 @@ fn clip_ears(
     }
     out.push([ring[2].0, ring[1].0, ring[0].0]);
     out
-}
-
-fn sub3(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
-}
-
-fn cross3(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
-}
-fn dot3(a: [f64; 3], b: [f64; 3]) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
-fn normalize3(a: [f64; 3]) -> [f64; 3] {
-    let l = dot3(a, a).sqrt();
-    [a[0] / l, a[1] / l, a[2] / l]
 }
 
 /// Twice the signed area of the closed polygon: positive when it runs counter-clockwise.

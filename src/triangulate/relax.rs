@@ -6,7 +6,7 @@
 //! derivatives, and MPFR runs stay comparable with `f64` ones. `p0` and boundary vertices stay
 //! where they are. Edge flips afterwards restore the surface Delaunay property.
 
-use super::flip::flip_to_surface_delaunay;
+use super::flip::{agreement_at, flip_to_surface_delaunay};
 use super::Mesh;
 use crate::params::MeshParams;
 use crate::sample::Samples;
@@ -147,28 +147,7 @@ fn keep_orientation<T: Scalar>(
     mut new: Vec<Vec3<T>>,
 ) -> Vec<Vec3<T>> {
     let agreement = |pos: &[Vec3<T>], t: &[u32; 3]| {
-        let [a, b, c] = t.map(|i| pos[i as usize].to_f64());
-        let u = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
-        let w = [c[0] - a[0], c[1] - a[1], c[2] - a[2]];
-        let f = [
-            u[1] * w[2] - u[2] * w[1],
-            u[2] * w[0] - u[0] * w[2],
-            u[0] * w[1] - u[1] * w[0],
-        ];
-        let mut g = [0.0; 3];
-        for &i in t {
-            for k in 0..3 {
-                g[k] += normals[i as usize][k];
-            }
-        }
-        let d = ((f[0] * f[0] + f[1] * f[1] + f[2] * f[2])
-            * (g[0] * g[0] + g[1] * g[1] + g[2] * g[2]))
-            .sqrt();
-        if d > 0.0 {
-            (f[0] * g[0] + f[1] * g[1] + f[2] * g[2]) / d
-        } else {
-            -1.0
-        }
+        agreement_at(t.map(|i| pos[i as usize].to_f64()), normals, *t)
     };
     // Positions are read through `to_f64` rather than copied: free for `f64`, and no second
     // copy of the mesh at the pipeline's peak memory.

@@ -8,9 +8,9 @@
 //! are taken out, and the larger hole is filled with a constrained Delaunay triangulation of
 //! its loop *and the points inside it*, projected across the region's mean normal.
 
+use super::flip::agreement;
 use super::{
-    cross3, dot3, frame_around, point_in_polygon, signed_area, simple_polygon, sub3, ChartVertex,
-    EdgeSet,
+    dot3, frame_around, point_in_polygon, signed_area, simple_polygon, ChartVertex, EdgeSet,
 };
 use spade::{ConstrainedDelaunayTriangulation, Point2, Triangulation as _};
 use std::collections::{HashMap, HashSet};
@@ -66,7 +66,7 @@ pub(super) fn reclose(
         .flat_map(|(i, t)| (0..3).map(move |k| (t[k], t[(k + 1) % 3], i as u32)))
         .filter(|&(a, b, _)| stars.holding(triangles, b, a).is_none())
         .collect();
-    let folded = |t: &[u32; 3]| agreement(pos, normals, t) < FOLDED;
+    let folded = |t: &[u32; 3]| agreement(pos, normals, *t) < FOLDED;
 
     // Folded triangles connected to the hole through folded triangles (sharing vertices).
     let mut in_region = vec![false; triangles.len()];
@@ -474,22 +474,4 @@ fn fill_polygon(
         }
     }
     Some(out)
-}
-
-/// Cosine between the face `t` and the sum of the field normals at its corners.
-fn agreement(pos: &[[f64; 3]], normals: &[[f64; 3]], t: &[u32; 3]) -> f64 {
-    let [a, b, c] = t.map(|i| pos[i as usize]);
-    let f = cross3(sub3(b, a), sub3(c, a));
-    let mut g = [0.0; 3];
-    for &i in t {
-        for k in 0..3 {
-            g[k] += normals[i as usize][k];
-        }
-    }
-    let d = (dot3(f, f) * dot3(g, g)).sqrt();
-    if d > 0.0 {
-        dot3(f, g) / d
-    } else {
-        -1.0
-    }
 }
