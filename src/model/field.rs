@@ -139,7 +139,9 @@ impl<T: Scalar> NormalField<T> for LieField<T> {
     fn normal(&self, p: &Vec3<T>) -> Vec3<T> {
         let v = mat_vec(&self.a, p);
         if self.quadratic {
-            &v + &mat_vec(&self.b, &self.lift.lower(p))
+            let mut v = v;
+            v += &mat_vec(&self.b, &self.lift.lower(p));
+            v
         } else {
             v
         }
@@ -154,7 +156,7 @@ impl<T: Scalar> NormalField<T> for LieField<T> {
         );
         let mut v = mat_vec_dual(&self.a, &pd);
         if self.quadratic {
-            v = &v + &mat_vec_dual(&self.b, &self.lift.lower(&pd));
+            v += &mat_vec_dual(&self.b, &self.lift.lower(&pd));
         }
         (
             Vec3::new(v.x.re, v.y.re, v.z.re),

@@ -56,11 +56,14 @@ impl Lift {
     #[inline(always)]
     pub fn lower<T: Scalar>(self, p: &Vec3<T>) -> Vec3<T> {
         match self {
-            Lift::Squares => Vec3::new(
-                p.x.clone() * p.x.clone(),
-                p.y.clone() * p.y.clone(),
-                p.z.clone() * p.z.clone(),
-            ),
+            Lift::Squares => {
+                let square = |x: &T| {
+                    let mut r = x.clone();
+                    r *= x;
+                    r
+                };
+                Vec3::new(square(&p.x), square(&p.y), square(&p.z))
+            }
         }
     }
 }

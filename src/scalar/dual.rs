@@ -18,12 +18,27 @@ use std::ops::{Add, AddAssign, Div, DivAssign, Mul, MulAssign, Neg, Rem, Sub, Su
 /// assert_eq!(y.re, 3.0);
 /// assert!((y.eps - 1.0).abs() < 1e-15);
 /// ```
-#[derive(Clone, Debug, Default, PartialEq)]
+#[derive(Debug, Default, PartialEq)]
 pub struct Dual<T> {
     /// The value.
     pub re: T,
     /// The derivative along the seeded direction.
     pub eps: T,
+}
+
+impl<T: Clone> Clone for Dual<T> {
+    #[inline(always)]
+    fn clone(&self) -> Self {
+        Dual {
+            re: self.re.clone(),
+            eps: self.eps.clone(),
+        }
+    }
+    #[inline(always)]
+    fn clone_from(&mut self, source: &Self) {
+        self.re.clone_from(&source.re);
+        self.eps.clone_from(&source.eps);
+    }
 }
 
 impl<T: Scalar> Dual<T> {
@@ -44,11 +59,10 @@ impl<T: Scalar> Dual<T> {
     }
     /// Multiplies both parts by a plain scalar (cheaper than a dual product).
     #[inline(always)]
-    pub fn scale(self, k: &T) -> Self {
-        Dual {
-            re: self.re * k.clone(),
-            eps: self.eps * k.clone(),
-        }
+    pub fn scale(mut self, k: &T) -> Self {
+        self.re *= k;
+        self.eps *= k;
+        self
     }
 }
 
@@ -126,6 +140,31 @@ impl<T: Scalar> SubAssign for Dual<T> {
         self.eps -= o.eps;
     }
 }
+impl<T: Scalar> AddAssign<&Dual<T>> for Dual<T> {
+    #[inline(always)]
+    fn add_assign(&mut self, o: &Self) {
+        self.re += &o.re;
+        self.eps += &o.eps;
+    }
+}
+impl<T: Scalar> SubAssign<&Dual<T>> for Dual<T> {
+    #[inline(always)]
+    fn sub_assign(&mut self, o: &Self) {
+        self.re -= &o.re;
+        self.eps -= &o.eps;
+    }
+}
+impl<T: Scalar> MulAssign<&Dual<T>> for Dual<T> {
+    /// The same operations, in the same order, as `*self = self * o`.
+    #[inline(always)]
+    fn mul_assign(&mut self, o: &Self) {
+        let mut cross = self.re.clone();
+        cross *= &o.eps;
+        self.eps *= &o.re;
+        self.eps += &cross;
+        self.re *= &o.re;
+    }
+}
 impl<T: Scalar> MulAssign for Dual<T> {
     #[inline(always)]
     fn mul_assign(&mut self, o: Self) {
@@ -175,6 +214,13 @@ impl<T: Scalar> Scalar for Dual<T> {
         let r = self.re.sqrt();
         let eps = self.eps.clone() / (r.clone() + r.clone());
         Dual::new(r, eps)
+    }
+    #[inline(always)]
+    fn sin_cos(&self) -> (Self, Self) {
+        let (s, c) = self.re.sin_cos();
+        let sin_eps = self.eps.clone() * c.clone();
+        let cos_eps = -(self.eps.clone() * s.clone());
+        (Dual::new(s, sin_eps), Dual::new(c, cos_eps))
     }
     #[inline(always)]
     fn sin(&self) -> Self {

@@ -37,6 +37,10 @@ use std::ops::{AddAssign, DivAssign, MulAssign, Neg, SubAssign};
 /// functions the algorithm uses, conversion to and from `f64` (discrete decisions and the
 /// output are made in `f64`), and [`Scalar::unit_roundoff`] so that tolerances can follow
 /// the working precision.
+///
+/// The compound assignments by reference (`x *= &y`) are what generic hot code uses: MPFR
+/// then works in place without copying the right operand, and for `f64` they are the
+/// plain operations.
 pub trait Scalar:
     Clone
     + Debug
@@ -48,6 +52,9 @@ pub trait Scalar:
     + SubAssign
     + MulAssign
     + DivAssign
+    + for<'a> AddAssign<&'a Self>
+    + for<'a> SubAssign<&'a Self>
+    + for<'a> MulAssign<&'a Self>
     + Send
     + Sync
     + 'static
@@ -62,6 +69,12 @@ pub trait Scalar:
     fn sin(&self) -> Self;
     /// Cosine (radians).
     fn cos(&self) -> Self;
+    /// Sine and cosine together: one call where the type computes both at once (MPFR),
+    /// exactly `(self.sin(), self.cos())` otherwise.
+    #[inline(always)]
+    fn sin_cos(&self) -> (Self, Self) {
+        (self.sin(), self.cos())
+    }
     /// Tangent (radians).
     fn tan(&self) -> Self;
     /// Four-quadrant arc tangent of `self / x`.

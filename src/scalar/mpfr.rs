@@ -20,8 +20,20 @@ use std::ops::{Add, AddAssign, Div, DivAssign, Mul, MulAssign, Neg, Rem, Sub, Su
 /// let back = third * Mpfr::from_f64(3.0) - Mpfr::from_f64(1.0);
 /// assert!(back.abs().to_f64() < 1e-70);
 /// ```
-#[derive(Clone, PartialEq, PartialOrd)]
+#[derive(PartialEq, PartialOrd)]
 pub struct Mpfr<const BITS: u32>(pub Float);
+
+impl<const BITS: u32> Clone for Mpfr<BITS> {
+    #[inline]
+    fn clone(&self) -> Self {
+        Mpfr(self.0.clone())
+    }
+    /// Reuses `self`'s limbs: all values of the type have the same precision.
+    #[inline]
+    fn clone_from(&mut self, source: &Self) {
+        self.0.clone_from(&source.0);
+    }
+}
 
 impl<const BITS: u32> Mpfr<BITS> {
     /// Wraps any value `rug` can convert, rounded to `BITS` bits.
@@ -65,6 +77,12 @@ macro_rules! binop {
         impl<const BITS: u32> $tra for Mpfr<BITS> {
             #[inline]
             fn $ma(&mut self, o: Self) {
+                self.0 $op &o.0;
+            }
+        }
+        impl<const BITS: u32> $tra<&Mpfr<BITS>> for Mpfr<BITS> {
+            #[inline]
+            fn $ma(&mut self, o: &Self) {
                 self.0 $op &o.0;
             }
         }
@@ -136,6 +154,10 @@ impl<const BITS: u32> Scalar for Mpfr<BITS> {
     }
     fn cos(&self) -> Self {
         Mpfr(self.0.clone().cos())
+    }
+    fn sin_cos(&self) -> (Self, Self) {
+        let (s, c) = self.0.clone().sin_cos(Float::new(BITS));
+        (Mpfr(s), Mpfr(c))
     }
     fn tan(&self) -> Self {
         Mpfr(self.0.clone().tan())

@@ -1,7 +1,7 @@
 //! A three-vector over any [`Scalar`].
 
 use super::Scalar;
-use std::ops::{Add, Index, Mul, Neg, Sub};
+use std::ops::{Add, AddAssign, Index, Mul, Neg, Sub, SubAssign};
 
 /// A vector of three scalars, the only vector type the generic pipeline uses.
 ///
@@ -41,15 +41,23 @@ impl<T: Scalar> Vec3<T> {
     /// Dot product.
     #[inline(always)]
     pub fn dot(&self, o: &Self) -> T {
-        self.x.clone() * o.x.clone() + self.y.clone() * o.y.clone() + self.z.clone() * o.z.clone()
+        let mut r = product(&self.x, &o.x);
+        r += &product(&self.y, &o.y);
+        r += &product(&self.z, &o.z);
+        r
     }
     /// Cross product.
     #[inline(always)]
     pub fn cross(&self, o: &Self) -> Self {
+        let minor = |a: &T, b: &T, c: &T, d: &T| {
+            let mut r = product(a, b);
+            r -= &product(c, d);
+            r
+        };
         Vec3::new(
-            self.y.clone() * o.z.clone() - self.z.clone() * o.y.clone(),
-            self.z.clone() * o.x.clone() - self.x.clone() * o.z.clone(),
-            self.x.clone() * o.y.clone() - self.y.clone() * o.x.clone(),
+            minor(&self.y, &o.z, &self.z, &o.y),
+            minor(&self.z, &o.x, &self.x, &o.z),
+            minor(&self.x, &o.y, &self.y, &o.x),
         )
     }
     /// Squared Euclidean norm.
@@ -66,18 +74,24 @@ impl<T: Scalar> Vec3<T> {
     #[inline(always)]
     pub fn scale(&self, k: &T) -> Self {
         Vec3::new(
-            self.x.clone() * k.clone(),
-            self.y.clone() * k.clone(),
-            self.z.clone() * k.clone(),
+            product(&self.x, k),
+            product(&self.y, k),
+            product(&self.z, k),
         )
     }
     /// `self + k·o`, the workhorse of the stepper.
     #[inline(always)]
     pub fn add_scaled(&self, k: &T, o: &Self) -> Self {
+        // `k·o + self` is `self + k·o` exactly: IEEE addition and multiplication commute.
+        let term = |a: &T, b: &T| {
+            let mut r = product(k, b);
+            r += a;
+            r
+        };
         Vec3::new(
-            self.x.clone() + k.clone() * o.x.clone(),
-            self.y.clone() + k.clone() * o.y.clone(),
-            self.z.clone() + k.clone() * o.z.clone(),
+            term(&self.x, &o.x),
+            term(&self.y, &o.y),
+            term(&self.z, &o.z),
         )
     }
     /// The unit vector along `self` and the norm, or `None` when the norm is zero or not finite.
@@ -109,6 +123,31 @@ impl<T: Scalar> Vec3<T> {
     }
 }
 
+/// `a·b` as a new value: one copy of `a`, multiplied in place (no copy of `b` for MPFR).
+#[inline(always)]
+fn product<T: Scalar>(a: &T, b: &T) -> T {
+    let mut r = a.clone();
+    r *= b;
+    r
+}
+
+impl<T: Scalar> AddAssign<&Vec3<T>> for Vec3<T> {
+    #[inline(always)]
+    fn add_assign(&mut self, o: &Vec3<T>) {
+        self.x += &o.x;
+        self.y += &o.y;
+        self.z += &o.z;
+    }
+}
+impl<T: Scalar> SubAssign<&Vec3<T>> for Vec3<T> {
+    #[inline(always)]
+    fn sub_assign(&mut self, o: &Vec3<T>) {
+        self.x -= &o.x;
+        self.y -= &o.y;
+        self.z -= &o.z;
+    }
+}
+
 impl<T: Scalar> Index<usize> for Vec3<T> {
     type Output = T;
     #[inline(always)]
@@ -125,11 +164,9 @@ impl<T: Scalar> Add for &Vec3<T> {
     type Output = Vec3<T>;
     #[inline(always)]
     fn add(self, o: Self) -> Vec3<T> {
-        Vec3::new(
-            self.x.clone() + o.x.clone(),
-            self.y.clone() + o.y.clone(),
-            self.z.clone() + o.z.clone(),
-        )
+        let mut r = self.clone();
+        r += o;
+        r
     }
 }
 impl<T: Scalar> Add for Vec3<T> {
@@ -143,11 +180,9 @@ impl<T: Scalar> Sub for &Vec3<T> {
     type Output = Vec3<T>;
     #[inline(always)]
     fn sub(self, o: Self) -> Vec3<T> {
-        Vec3::new(
-            self.x.clone() - o.x.clone(),
-            self.y.clone() - o.y.clone(),
-            self.z.clone() - o.z.clone(),
-        )
+        let mut r = self.clone();
+        r -= o;
+        r
     }
 }
 impl<T: Scalar> Sub for Vec3<T> {

@@ -197,8 +197,15 @@ pub fn step<T: Scalar, F: NormalField<T>>(
                 dt = cfg.dt_min.clone();
                 limit = StepLimit::Clamped;
             }
-            let alpha = angle(&dt);
-            if limit == StepLimit::None && (alpha < cfg.beta_min || alpha > cfg.beta_max) {
+            // α only reports on the closed-form Δt here, so `f64` is enough (and it is the
+            // same number for `f64` and `Dual<f64>`); MPFR is spared an arc tangent.
+            let alpha = {
+                let (v, jw) = (Vec3::from_f64(v.to_f64()), Vec3::from_f64(jw.to_f64()));
+                v.angle_to(&v.add_scaled(&dt.to_f64(), &jw))
+            };
+            if limit == StepLimit::None
+                && (alpha < cfg.beta_min.to_f64() || alpha > cfg.beta_max.to_f64())
+            {
                 limit = StepLimit::Clamped;
             }
             let kappa = w.dot(&jw) / vlen.clone();
@@ -217,7 +224,7 @@ pub fn step<T: Scalar, F: NormalField<T>>(
                 carry,
                 tangent: w,
                 normal: n,
-                alpha_predicted: alpha.to_f64(),
+                alpha_predicted: alpha,
                 dt,
                 iterations: chord.iterations,
                 limit,
@@ -290,7 +297,7 @@ fn drift_free_chord<T: Scalar, F: NormalField<T>>(
     let mut converged = false;
     for _ in 0..newton_budget {
         iterations += 1;
-        let (s, c) = (phi.sin(), phi.cos());
+        let (s, c) = phi.sin_cos();
         let dir = w.scale(&c).add_scaled(&s, n);
         let perp = n.scale(&c).add_scaled(&-s, w);
         let pm = p.add_scaled(&half_len, &dir);
@@ -312,7 +319,7 @@ fn drift_free_chord<T: Scalar, F: NormalField<T>>(
             break;
         }
     }
-    let (s, c) = (phi.sin(), phi.cos());
+    let (s, c) = phi.sin_cos();
     let direction = w.scale(&c).add_scaled(&s, n);
     let point = p.add_scaled(length, &direction);
     if !point.is_finite() {

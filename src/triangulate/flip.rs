@@ -288,6 +288,28 @@ impl<'a> HalfEdges<'a> {
     }
 }
 
+/// One bit per triangle (an eighth of the memory of `Vec<bool>` at the pipeline's peak).
+struct FlagSet(Vec<u64>);
+
+impl FlagSet {
+    fn new(len: usize) -> Self {
+        FlagSet(vec![0; len.div_ceil(64)])
+    }
+    #[inline]
+    fn get(&self, i: usize) -> bool {
+        self.0[i / 64] >> (i % 64) & 1 == 1
+    }
+    #[inline]
+    fn set(&mut self, i: usize, on: bool) {
+        let bit = 1u64 << (i % 64);
+        if on {
+            self.0[i / 64] |= bit;
+        } else {
+            self.0[i / 64] &= !bit;
+        }
+    }
+}
+
 /// Flips edges of `triangles` in place; returns the number of flips. At most
 /// `budget` flips are made. Triangles that do not form a consistently oriented 2-manifold
 /// are left as they are (a flip there could make an edge non-manifold).
@@ -309,6 +331,14 @@ pub(crate) fn flip_to_surface_delaunay(
         .flat_map(|t| (0..3).map(move |k| (t[k], t[(k + 1) % 3])))
         .filter(|&(a, b)| a < b)
         .collect();
+    // Which triangles face against the field, computed once: a flip only ever creates
+    // triangles that agree with it, so the flags change only by being cleared.
+    let mut folded = FlagSet::new(he.tri.len());
+    for (t, tri) in he.tri.iter().enumerate() {
+        if agreement(points, normals, *tri) <= 0.0 {
+            folded.set(t, true);
+        }
+    }
     let mut flips = 0;
     let mut visits = 0usize;
     while let Some((a, b)) = queue.pop_front() {
@@ -338,15 +368,10 @@ pub(crate) fn flip_to_surface_delaunay(
         let new2 = [d, b, c];
         // The tests, cheapest and most often decisive first (almost every edge is already
         // Delaunay and unfolded).
-        let folded =
-            || agreement(points, normals, old1) <= 0.0 || agreement(points, normals, old2) <= 0.0;
-        let was_folded = if delaunay_violation(pa, pb, pc, pd) {
-            None
-        } else if folded() {
-            Some(true)
-        } else {
+        let was_folded = folded.get(t1 as usize) || folded.get(t2 as usize);
+        if !was_folded && !delaunay_violation(pa, pb, pc, pd) {
             continue;
-        };
+        }
         if c == d || he.adjacent(c, d) {
             continue;
         }
@@ -363,11 +388,13 @@ pub(crate) fn flip_to_surface_delaunay(
         };
         if (dot(face_normal(points, new1), old_sum) <= 0.0
             || dot(face_normal(points, new2), old_sum) <= 0.0)
-            && !was_folded.unwrap_or_else(folded)
+            && !was_folded
         {
             continue;
         }
         he.flip(t1, t2, [a, b, c, d]);
+        folded.set(t1 as usize, false);
+        folded.set(t2 as usize, false);
         flips += 1;
         for (x, y) in [(a, d), (d, b), (b, c), (c, a)] {
             queue.push_back((x.min(y), x.max(y)));

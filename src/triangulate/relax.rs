@@ -98,6 +98,9 @@ pub(crate) fn relax<T: Scalar, F: NormalField<T>>(
     let neighbours = |v: usize| &adj[start[v] as usize..(start[v] + len[v]) as usize];
     let cfg = StepConfig::<T>::new(params);
     let damping = T::from_f64(DAMPING);
+    // Each face's agreement with the field at the current positions, carried from one
+    // sweep's check to the next sweep's starting point.
+    let mut agreement: Option<Vec<f64>> = None;
     for _ in 0..SWEEPS {
         let moved: Vec<Vec3<T>> = (0..n)
             .map(|v| {
@@ -118,9 +121,10 @@ pub(crate) fn relax<T: Scalar, F: NormalField<T>>(
                 trace::step_fixed(field, &cfg, &pos[v], &d, &len).unwrap_or_else(|_| pos[v].clone())
             })
             .collect();
-        pos = keep_orientation(&mesh.triangles, &mesh.normals, pos, moved);
+        let kept = keep_orientation(&mesh.triangles, &mesh.normals, pos, moved, agreement);
+        (pos, agreement) = (kept.0, Some(kept.1));
     }
-    drop((adj, start, len, fixed));
+    drop((adj, start, len, fixed, agreement));
     // The neighbour lists are gone by now, and the vertices and normals are written in
     // place: the flip pass below is the peak of the pipeline's memory.
     for ((v, nrm), p) in mesh.vertices.iter_mut().zip(&mut mesh.normals).zip(&pos) {
@@ -139,29 +143,49 @@ const MIN_AGREEMENT: f64 = 0.5;
 
 /// Accepts the sweep's moves except where a triangle would fold: the vertices of every
 /// triangle whose face normal turns away from the field normal (and did not before) go back
-/// to where they were, until no such triangle is left.
+/// to where they were, until no such triangle is left. `before` holds each face's agreement
+/// at `old` if known; returns the positions and each face's agreement at them.
 fn keep_orientation<T: Scalar>(
     triangles: &[[u32; 3]],
     normals: &[[f64; 3]],
     old: Vec<Vec3<T>>,
     mut new: Vec<Vec3<T>>,
-) -> Vec<Vec3<T>> {
+    before: Option<Vec<f64>>,
+) -> (Vec<Vec3<T>>, Vec<f64>) {
     let agreement = |pos: &[Vec3<T>], t: &[u32; 3]| {
         agreement_at(t.map(|i| pos[i as usize].to_f64()), normals, *t)
     };
     // Positions are read through `to_f64` rather than copied: free for `f64`, and no second
     // copy of the mesh at the pipeline's peak memory.
-    let before: Vec<f64> = triangles.iter().map(|t| agreement(&old, t)).collect();
+    let before: Vec<f64> =
+        before.unwrap_or_else(|| triangles.iter().map(|t| agreement(&old, t)).collect());
+    // Every face is checked in the first round, and again whenever a corner went back, so
+    // the last value computed for a face is its agreement at the final positions.
+    let mut now = vec![0.0; triangles.len()];
+    // The round in which each vertex went back (a vertex goes back at most once). After the
+    // first round only triangles with a vertex that went back in this round or the last can
+    // have changed since they were checked; the others would pass again.
+    const NEVER: u32 = u32::MAX;
+    let mut reverted_in = vec![NEVER; new.len()];
     // Each round reverts at least one moved vertex, so this ends within `new.len()` rounds.
-    for _ in 0..=new.len() {
+    for round in 0..=new.len() as u32 {
         let mut reverted = false;
-        for (t, &b) in triangles.iter().zip(&before) {
+        for ((t, &b), a) in triangles.iter().zip(&before).zip(&mut now) {
+            let changed = |&i: &u32| {
+                let r = reverted_in[i as usize];
+                r != NEVER && r + 1 >= round
+            };
+            if round > 0 && !t.iter().any(changed) {
+                continue;
+            }
             let limit = MIN_AGREEMENT.min(b);
-            if agreement(&new, t) < limit {
+            *a = agreement(&new, t);
+            if *a < limit {
                 for &i in t {
                     let i = i as usize;
                     if new[i].to_f64() != old[i].to_f64() {
                         new[i] = old[i].clone();
+                        reverted_in[i] = round;
                         reverted = true;
                     }
                 }
@@ -171,5 +195,5 @@ fn keep_orientation<T: Scalar>(
             break;
         }
     }
-    new
+    (new, now)
 }
