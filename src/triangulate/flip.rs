@@ -7,7 +7,8 @@
 //! when it keeps the mesh a consistently oriented 2-manifold whose faces agree with the field
 //! normal; flips that undo a fold (a face against the field normal) come first.
 
-use crate::scalar::f64x3::{cross, dot, sub};
+use crate::scalar::f64x3::{cross, dot, sub, FastHash};
+use std::collections::{HashMap, VecDeque};
 
 /// Angle at `c` in triangle (a, b, c).
 fn angle_at(c: [f64; 3], a: [f64; 3], b: [f64; 3]) -> f64 {
@@ -323,14 +324,14 @@ pub(crate) fn flip_to_surface_delaunay(
     let Some(mut he) = HalfEdges::new(triangles, points.len()) else {
         return 0;
     };
-    // Every edge once, in triangle order (built after `HalfEdges::new` has freed its
-    // scratch, to keep the peak memory down).
-    let mut queue: std::collections::VecDeque<(u32, u32)> = he
-        .tri
-        .iter()
-        .flat_map(|t| (0..3).map(move |k| (t[k], t[(k + 1) % 3])))
-        .filter(|&(a, b)| a < b)
-        .collect();
+    // The queue: every edge once, in triangle order, then the edges around each flip in
+    // the order of the flips. The first part is not stored but read from the triangles'
+    // slots at `cursor` (with the half-edge's index for free); the few triangles that a flip
+    // rewrites before the cursor has read them are kept as they were in `unread`.
+    let slots = 3 * he.tri.len();
+    let mut cursor = 0usize;
+    let mut unread: HashMap<u32, [u32; 3], FastHash> = HashMap::default();
+    let mut queue: VecDeque<(u32, u32)> = VecDeque::new();
     // Which triangles face against the field, computed once: a flip only ever creates
     // triangles that agree with it, so the flags change only by being cleared.
     let mut folded = FlagSet::new(he.tri.len());
@@ -341,13 +342,35 @@ pub(crate) fn flip_to_surface_delaunay(
     }
     let mut flips = 0;
     let mut visits = 0usize;
-    while let Some((a, b)) = queue.pop_front() {
+    loop {
+        let (a, b, slot) = if cursor < slots {
+            let (h, t, k) = (cursor as u32, cursor / 3, cursor % 3);
+            cursor += 1;
+            let tri = match unread.get(&(t as u32)) {
+                Some(&tri) if k == 2 => unread.remove(&(t as u32)).unwrap_or(tri),
+                Some(&tri) => tri,
+                None => he.tri[t],
+            };
+            let (a, b) = (tri[k], tri[(k + 1) % 3]);
+            if a >= b {
+                continue;
+            }
+            (a, b, Some(h))
+        } else if let Some((a, b)) = queue.pop_front() {
+            (a, b, None)
+        } else {
+            break;
+        };
         visits += 1;
         if flips >= budget || visits > max_visits {
             break;
         }
-        let Some(h) = he.find(a, b) else {
-            continue;
+        let h = match slot {
+            Some(h) if he.origin(h) == a && he.dest(h) == b => h,
+            _ => match he.find(a, b) {
+                Some(h) => h,
+                None => continue,
+            },
         };
         let g = he.twin[h as usize];
         if g == NONE {
@@ -391,6 +414,11 @@ pub(crate) fn flip_to_surface_delaunay(
             && !was_folded
         {
             continue;
+        }
+        for t in [t1, t2] {
+            if 3 * t as usize + 2 >= cursor {
+                unread.entry(t).or_insert(he.tri[t as usize]);
+            }
         }
         he.flip(t1, t2, [a, b, c, d]);
         folded.set(t1 as usize, false);
