@@ -125,6 +125,8 @@ struct Live<T> {
     /// Paper mode: how far explicit Euler has carried the curve off the surface, estimated
     /// as `Σ Δt·α/2` (a chord of length Δt across a turn of α leaves the arc by about that).
     drift: f64,
+    /// `(cos θ, sin θ)` of the curve's angle at `p0`: its points' chart direction.
+    chart_dir: [f64; 2],
 }
 
 /// Samples the surface of `field` from `params.p0` (paper Steps 2–7).
@@ -213,6 +215,7 @@ pub fn sample<T: Scalar, F: NormalField<T>>(
             right: (j + 1) % n,
             active: true,
             drift: 0.0,
+            chart_dir: [theta.cos(), theta.sin()],
         });
         s.heap.push(Reverse((s.order_key(0.0), j)));
     }
@@ -314,7 +317,8 @@ impl<T: Scalar, F: NormalField<T>> Sampler<'_, T, F> {
             return Some(CurveEnd::BoundingBox);
         }
         let theta = self.out.curves[ci].theta;
-        let chart_q = [s_new * theta.cos(), s_new * theta.sin()];
+        let dir = live.chart_dir;
+        let chart_q = [s_new * dir[0], s_new * dir[1]];
         let drift = live.drift + 0.5 * len * step.alpha_predicted;
         let normal = (!self.drift.is_empty()).then(|| step.normal.to_f64());
         if self.params.terminal.close && self.collides(q, chart_q, len, normal, drift) {
@@ -530,7 +534,8 @@ impl<T: Scalar, F: NormalField<T>> Sampler<'_, T, F> {
         if s > self.params.terminal.max_radius || start_f.iter().any(|x| x.abs() > bb) {
             return;
         }
-        let chart = [s * theta.cos(), s * theta.sin()];
+        let chart_dir = [theta.cos(), theta.sin()];
+        let chart = [s * chart_dir[0], s * chart_dir[1]];
         let drift = 0.5 * (self.live[c as usize].drift + self.live[k as usize].drift);
         let normal = if self.drift.is_empty() {
             None
@@ -578,6 +583,7 @@ impl<T: Scalar, F: NormalField<T>> Sampler<'_, T, F> {
             right,
             active: true,
             drift,
+            chart_dir,
         });
         self.live[left as usize].right = id;
         self.live[right as usize].left = id;

@@ -72,7 +72,22 @@ pub fn triangulate<T: Scalar>(
             "only {n} sample point(s); the curves ended right away (check p0, Δt and the terminal conditions)"
         )));
     }
-    let chart: Vec<[f64; 2]> = (0..n).map(|i| samples.chart(i)).collect();
+    // `Samples::chart`, with each curve's (cos θ, sin θ) computed once: the points of a
+    // curve share θ (checked, since hand-built samples need not).
+    let mut dirs: Vec<(f64, [f64; 2])> = vec![(f64::NAN, [0.0; 2]); samples.curves.len()];
+    let chart: Vec<[f64; 2]> = samples
+        .provenance
+        .iter()
+        .map(|pr| {
+            let mut fresh = (f64::NAN, [0.0; 2]);
+            let (theta, dir) = dirs.get_mut(pr.curve as usize).unwrap_or(&mut fresh);
+            if theta.to_bits() != pr.theta.to_bits() {
+                *theta = pr.theta;
+                *dir = [pr.theta.cos(), pr.theta.sin()];
+            }
+            [pr.s * dir[0], pr.s * dir[1]]
+        })
+        .collect();
     let front = front_polygon(samples, &chart);
     let pos: Vec<[f64; 3]> = samples.points.iter().map(|p| p.to_f64()).collect();
 
