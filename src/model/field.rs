@@ -9,6 +9,9 @@ use crate::scalar::{Dual, Scalar, Vec3};
 /// (the paper's eq. 8–9). Implement both for your own field, or wrap a closure written for
 /// dual numbers in [`FnField`], which gets both from one forward-mode pass.
 ///
+/// A field is a pure function, so it must be `Sync`: the relaxation evaluates it on all
+/// cores at once (the result does not depend on how many).
+///
 /// Implement it for every `T: Scalar` at once to be able to audit your field in `f32`, `f64`
 /// and MPFR:
 ///
@@ -29,7 +32,7 @@ use crate::scalar::{Dual, Scalar, Vec3};
 /// let (v, jw) = NormalField::<f64>::normal_and_jvp(&Radial, &Vec3::new(0.0, 0.0, 1.0), &Vec3::new(1.0, 0.0, 0.0));
 /// assert_eq!((v.z, jw.x), (1.0, 1.0));
 /// ```
-pub trait NormalField<T: Scalar> {
+pub trait NormalField<T: Scalar>: Sync {
     /// `v(p)`.
     fn normal(&self, p: &Vec3<T>) -> Vec3<T>;
     /// `(v(p), J_v(p) w)`.
@@ -183,13 +186,13 @@ impl<T: Scalar> NormalField<T> for LieField<T> {
 pub struct FnField<F>(pub F);
 
 impl<F> FnField<F> {
-    /// Wraps a closure `Fn(&Vec3<Dual<T>>) -> Vec3<Dual<T>>`.
+    /// Wraps a closure `Fn(&Vec3<Dual<T>>) -> Vec3<Dual<T>> + Sync`.
     pub fn new(f: F) -> Self {
         FnField(f)
     }
 }
 
-impl<T: Scalar, F: Fn(&Vec3<Dual<T>>) -> Vec3<Dual<T>>> NormalField<T> for FnField<F> {
+impl<T: Scalar, F: Fn(&Vec3<Dual<T>>) -> Vec3<Dual<T>> + Sync> NormalField<T> for FnField<F> {
     fn normal(&self, p: &Vec3<T>) -> Vec3<T> {
         let v = (self.0)(&p.map(|x| Dual::constant(x.clone())));
         v.map(|d| d.re.clone())

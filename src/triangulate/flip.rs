@@ -8,6 +8,7 @@
 //! normal; flips that undo a fold (a face against the field normal) come first.
 
 use crate::scalar::f64x3::{cross, dot, sub, FastHash};
+use rayon::prelude::*;
 use std::collections::{HashMap, VecDeque};
 
 /// Angle at `c` in triangle (a, b, c).
@@ -289,13 +290,11 @@ impl<'a> HalfEdges<'a> {
     }
 }
 
-/// One bit per triangle (an eighth of the memory of `Vec<bool>` at the pipeline's peak).
+/// One bit per triangle, bit `t % 64` of word `t / 64` (an eighth of the memory of
+/// `Vec<bool>` at the pipeline's peak).
 struct FlagSet(Vec<u64>);
 
 impl FlagSet {
-    fn new(len: usize) -> Self {
-        FlagSet(vec![0; len.div_ceil(64)])
-    }
     #[inline]
     fn get(&self, i: usize) -> bool {
         self.0[i / 64] >> (i % 64) & 1 == 1
@@ -334,12 +333,16 @@ pub(crate) fn flip_to_surface_delaunay(
     let mut queue: VecDeque<(u32, u32)> = VecDeque::new();
     // Which triangles face against the field, computed once: a flip only ever creates
     // triangles that agree with it, so the flags change only by being cleared.
-    let mut folded = FlagSet::new(he.tri.len());
-    for (t, tri) in he.tri.iter().enumerate() {
-        if agreement(points, normals, *tri) <= 0.0 {
-            folded.set(t, true);
-        }
-    }
+    let mut folded = FlagSet(
+        he.tri
+            .par_chunks(64)
+            .map(|chunk| {
+                chunk.iter().enumerate().fold(0u64, |bits, (k, tri)| {
+                    bits | u64::from(agreement(points, normals, *tri) <= 0.0) << k
+                })
+            })
+            .collect(),
+    );
     let mut flips = 0;
     let mut visits = 0usize;
     loop {

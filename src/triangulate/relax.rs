@@ -13,6 +13,7 @@ use crate::sample::Samples;
 use crate::scalar::{Scalar, Vec3};
 use crate::trace::{self, StepConfig};
 use crate::NormalField;
+use rayon::prelude::*;
 
 /// Relaxation sweeps; three take the worst angles from the sampler's ~19° to above 20°
 /// on the presets and the ellipsoid while moving vertices by a fraction of a step.
@@ -103,6 +104,7 @@ pub(crate) fn relax<T: Scalar, F: NormalField<T>>(
     let mut agreement: Option<Vec<f64>> = None;
     for _ in 0..SWEEPS {
         let moved: Vec<Vec3<T>> = (0..n)
+            .into_par_iter()
             .map(|v| {
                 let nb = neighbours(v);
                 if fixed[v] || nb.is_empty() {
@@ -127,12 +129,16 @@ pub(crate) fn relax<T: Scalar, F: NormalField<T>>(
     drop((adj, start, len, fixed, agreement));
     // The neighbour lists are gone by now, and the vertices and normals are written in
     // place: the flip pass below is the peak of the pipeline's memory.
-    for ((v, nrm), p) in mesh.vertices.iter_mut().zip(&mut mesh.normals).zip(&pos) {
-        *v = p.to_f64();
-        *nrm = trace::unit_normal(field, p)
-            .map(|(_, n, _)| n.to_f64())
-            .unwrap_or([0.0; 3]);
-    }
+    mesh.vertices
+        .par_iter_mut()
+        .zip(mesh.normals.par_iter_mut())
+        .zip(pos.par_iter())
+        .for_each(|((v, nrm), p)| {
+            *v = p.to_f64();
+            *nrm = trace::unit_normal(field, p)
+                .map(|(_, n, _)| n.to_f64())
+                .unwrap_or([0.0; 3]);
+        });
     let budget = 8 * mesh.triangles.len() + 64;
     flip_to_surface_delaunay(&mesh.vertices, &mesh.normals, &mut mesh.triangles, budget);
     pos
@@ -158,10 +164,12 @@ fn keep_orientation<T: Scalar>(
     // Positions are read through `to_f64` rather than copied: free for `f64`, and no second
     // copy of the mesh at the pipeline's peak memory.
     let before: Vec<f64> =
-        before.unwrap_or_else(|| triangles.iter().map(|t| agreement(&old, t)).collect());
+        before.unwrap_or_else(|| triangles.par_iter().map(|t| agreement(&old, t)).collect());
     // Every face is checked in the first round, and again whenever a corner went back, so
-    // the last value computed for a face is its agreement at the final positions.
-    let mut now = vec![0.0; triangles.len()];
+    // the last value computed for a face is its agreement at the final positions. The first
+    // round's values are computed up front, in parallel; the round itself recomputes a
+    // face's value only if a corner went back earlier in the round.
+    let mut now: Vec<f64> = triangles.par_iter().map(|t| agreement(&new, t)).collect();
     // The round in which each vertex went back (a vertex goes back at most once). After the
     // first round only triangles with a vertex that went back in this round or the last can
     // have changed since they were checked; the others would pass again.
@@ -178,8 +186,10 @@ fn keep_orientation<T: Scalar>(
             if round > 0 && !t.iter().any(changed) {
                 continue;
             }
+            if round > 0 || t.iter().any(|&i| reverted_in[i as usize] == 0) {
+                *a = agreement(&new, t);
+            }
             let limit = MIN_AGREEMENT.min(b);
-            *a = agreement(&new, t);
             if *a < limit {
                 for &i in t {
                     let i = i as usize;
