@@ -32,6 +32,7 @@ mod error;
 pub mod fuzz_checks;
 pub mod io;
 pub mod model;
+mod par;
 mod params;
 pub mod preset;
 pub mod quality;

@@ -352,7 +352,7 @@ impl<T: Scalar, F: NormalField<T>> Sampler<'_, T, F> {
         });
         self.out.curves[ci].points.push(index);
         self.pos.push(q);
-        self.chart.push(self.out.chart(index as usize));
+        self.chart.push(chart_q);
         self.grid.insert(q, index);
         if !self.drift.is_empty() {
             self.drift.push(drift);
@@ -568,7 +568,7 @@ impl<T: Scalar, F: NormalField<T>> Sampler<'_, T, F> {
             end: CurveEnd::Budget,
         });
         self.pos.push(start_f);
-        self.chart.push(self.out.chart(index as usize));
+        self.chart.push(chart);
         self.grid.insert(start_f, index);
         if !self.drift.is_empty() {
             self.drift.push(drift);

@@ -7,8 +7,8 @@
 //! when it keeps the mesh a consistently oriented 2-manifold whose faces agree with the field
 //! normal; flips that undo a fold (a face against the field normal) come first.
 
+use crate::par;
 use crate::scalar::f64x3::{cross, dot, sub, FastHash};
-use rayon::prelude::*;
 use std::collections::{HashMap, VecDeque};
 
 /// Angle at `c` in triangle (a, b, c).
@@ -333,16 +333,13 @@ pub(crate) fn flip_to_surface_delaunay(
     let mut queue: VecDeque<(u32, u32)> = VecDeque::new();
     // Which triangles face against the field, computed once: a flip only ever creates
     // triangles that agree with it, so the flags change only by being cleared.
-    let mut folded = FlagSet(
-        he.tri
-            .par_chunks(64)
-            .map(|chunk| {
-                chunk.iter().enumerate().fold(0u64, |bits, (k, tri)| {
-                    bits | u64::from(agreement(points, normals, *tri) <= 0.0) << k
-                })
-            })
-            .collect(),
-    );
+    let tri = &*he.tri;
+    let mut folded = FlagSet(par::map(tri.len().div_ceil(64), par::MIN_CHEAP / 64, |w| {
+        let chunk = &tri[64 * w..(64 * w + 64).min(tri.len())];
+        chunk.iter().enumerate().fold(0u64, |bits, (k, t)| {
+            bits | u64::from(agreement(points, normals, *t) <= 0.0) << k
+        })
+    }));
     let mut flips = 0;
     let mut visits = 0usize;
     loop {

@@ -22,6 +22,7 @@ pub(crate) use relax::relax;
 pub use mesh::{Mesh, Provenance};
 
 use crate::error::MeshError;
+use crate::par;
 use crate::sample::{CurveEnd, Samples};
 use crate::scalar::f64x3::{
     cross as cross3, dot as dot3, normalize as normalize3, sub as sub3, FastHash,
@@ -300,15 +301,15 @@ fn chart_triangles(chart: &[[f64; 2]], front: &[u32]) -> Result<Vec<[u32; 3]>, M
         (0.0, Vec::new())
     };
     let inside = |c: [f64; 2]| !use_front || inside_star(chart, front, (a0, &rel), c);
-    let mut triangles = Vec::with_capacity(2 * chart.len());
-    for face in cdt.inner_faces() {
-        let [a, b, c] = face.vertices();
+    // The faces are tested in parallel and kept in spade's order.
+    let faces: Vec<_> = cdt.fixed_inner_faces().collect();
+    let triangles = par::filter_map(faces.len(), par::MIN_CHEAP, |i| {
+        let [a, b, c] = cdt.face(faces[i]).vertices();
         let (pa, pb, pc) = (a.position(), b.position(), c.position());
         let centroid = [(pa.x + pb.x + pc.x) / 3.0, (pa.y + pb.y + pc.y) / 3.0];
-        if inside(centroid) && !rounding_sliver(pa, pb, pc) {
-            triangles.push([a.data().index, b.data().index, c.data().index]);
-        }
-    }
+        (inside(centroid) && !rounding_sliver(pa, pb, pc))
+            .then(|| [a.data().index, b.data().index, c.data().index])
+    });
     Ok(triangles)
 }
 

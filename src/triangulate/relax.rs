@@ -8,12 +8,12 @@
 
 use super::flip::{agreement_at, flip_to_surface_delaunay};
 use super::Mesh;
+use crate::par;
 use crate::params::MeshParams;
 use crate::sample::Samples;
 use crate::scalar::{Scalar, Vec3};
 use crate::trace::{self, StepConfig};
 use crate::NormalField;
-use rayon::prelude::*;
 
 /// Relaxation sweeps; three take the worst angles from the sampler's ~19° to above 20°
 /// on the presets and the ellipsoid while moving vertices by a fraction of a step.
@@ -103,42 +103,37 @@ pub(crate) fn relax<T: Scalar, F: NormalField<T>>(
     // sweep's check to the next sweep's starting point.
     let mut agreement: Option<Vec<f64>> = None;
     for _ in 0..SWEEPS {
-        let moved: Vec<Vec3<T>> = (0..n)
-            .into_par_iter()
-            .map(|v| {
-                let nb = neighbours(v);
-                if fixed[v] || nb.is_empty() {
-                    return pos[v].clone();
-                }
-                let mut c = Vec3::<T>::zero();
-                for &u in nb {
-                    c = &c + &pos[u as usize];
-                }
-                let c = c.scale(&(T::one() / T::from_f64(nb.len() as f64)));
-                let d = &c - &pos[v];
-                let len = d.norm() * damping.clone();
-                if len.partial_cmp(&T::zero()) != Some(std::cmp::Ordering::Greater) {
-                    return pos[v].clone();
-                }
-                trace::step_fixed(field, &cfg, &pos[v], &d, &len).unwrap_or_else(|_| pos[v].clone())
-            })
-            .collect();
+        let moved: Vec<Vec3<T>> = par::map(n, par::MIN_COSTLY, |v| {
+            let nb = neighbours(v);
+            if fixed[v] || nb.is_empty() {
+                return pos[v].clone();
+            }
+            let mut c = Vec3::<T>::zero();
+            for &u in nb {
+                c = &c + &pos[u as usize];
+            }
+            let c = c.scale(&(T::one() / T::from_f64(nb.len() as f64)));
+            let d = &c - &pos[v];
+            let len = d.norm() * damping.clone();
+            if len.partial_cmp(&T::zero()) != Some(std::cmp::Ordering::Greater) {
+                return pos[v].clone();
+            }
+            trace::step_fixed(field, &cfg, &pos[v], &d, &len).unwrap_or_else(|_| pos[v].clone())
+        });
         let kept = keep_orientation(&mesh.triangles, &mesh.normals, pos, moved, agreement);
         (pos, agreement) = (kept.0, Some(kept.1));
     }
     drop((adj, start, len, fixed, agreement));
     // The neighbour lists are gone by now, and the vertices and normals are written in
     // place: the flip pass below is the peak of the pipeline's memory.
-    mesh.vertices
-        .par_iter_mut()
-        .zip(mesh.normals.par_iter_mut())
-        .zip(pos.par_iter())
-        .for_each(|((v, nrm), p)| {
-            *v = p.to_f64();
-            *nrm = trace::unit_normal(field, p)
-                .map(|(_, n, _)| n.to_f64())
-                .unwrap_or([0.0; 3]);
-        });
+    for (v, p) in mesh.vertices.iter_mut().zip(&pos) {
+        *v = p.to_f64();
+    }
+    par::for_each_mut(&mut mesh.normals, par::MIN_COSTLY, |i, nrm| {
+        *nrm = trace::unit_normal(field, &pos[i])
+            .map(|(_, n, _)| n.to_f64())
+            .unwrap_or([0.0; 3]);
+    });
     let budget = 8 * mesh.triangles.len() + 64;
     flip_to_surface_delaunay(&mesh.vertices, &mesh.normals, &mut mesh.triangles, budget);
     pos
@@ -163,13 +158,18 @@ fn keep_orientation<T: Scalar>(
     };
     // Positions are read through `to_f64` rather than copied: free for `f64`, and no second
     // copy of the mesh at the pipeline's peak memory.
-    let before: Vec<f64> =
-        before.unwrap_or_else(|| triangles.par_iter().map(|t| agreement(&old, t)).collect());
+    let before: Vec<f64> = before.unwrap_or_else(|| {
+        par::map(triangles.len(), par::MIN_CHEAP, |t| {
+            agreement(&old, &triangles[t])
+        })
+    });
     // Every face is checked in the first round, and again whenever a corner went back, so
     // the last value computed for a face is its agreement at the final positions. The first
     // round's values are computed up front, in parallel; the round itself recomputes a
     // face's value only if a corner went back earlier in the round.
-    let mut now: Vec<f64> = triangles.par_iter().map(|t| agreement(&new, t)).collect();
+    let mut now = par::map(triangles.len(), par::MIN_CHEAP, |t| {
+        agreement(&new, &triangles[t])
+    });
     // The round in which each vertex went back (a vertex goes back at most once). After the
     // first round only triangles with a vertex that went back in this round or the last can
     // have changed since they were checked; the others would pass again.

@@ -1,0 +1,66 @@
+//! Order-preserving parallel maps that stay on the calling thread when the work is small.
+//!
+//! Waking rayon's workers costs tens of microseconds, more than a preset's whole relaxation
+//! sweep, so each map runs in parallel only from `min` items up. Either way the results come
+//! back in index order and are the same: the callers map pure functions.
+
+use rayon::prelude::*;
+
+/// Items from which a map of cheap work (tens of nanoseconds each: a face test) goes parallel.
+pub(crate) const MIN_CHEAP: usize = 16_384;
+/// Items from which a map of costly work (microseconds each: field evaluations) goes parallel.
+pub(crate) const MIN_COSTLY: usize = 256;
+
+/// `(0..n).map(f).collect()`, in parallel when `n >= min`.
+pub(crate) fn map<R: Send>(n: usize, min: usize, f: impl Fn(usize) -> R + Sync + Send) -> Vec<R> {
+    if n < min {
+        (0..n).map(f).collect()
+    } else {
+        (0..n).into_par_iter().map(f).collect()
+    }
+}
+
+/// `(0..n).filter_map(f).collect()`, in parallel when `n >= min`.
+pub(crate) fn filter_map<R: Send>(
+    n: usize,
+    min: usize,
+    f: impl Fn(usize) -> Option<R> + Sync + Send,
+) -> Vec<R> {
+    if n < min {
+        (0..n).filter_map(f).collect()
+    } else {
+        (0..n).into_par_iter().filter_map(f).collect()
+    }
+}
+
+/// Calls `f(i, &mut items[i])` for every item, in parallel when there are at least `min`.
+pub(crate) fn for_each_mut<X: Send>(
+    items: &mut [X],
+    min: usize,
+    f: impl Fn(usize, &mut X) + Sync + Send,
+) {
+    if items.len() < min {
+        items.iter_mut().enumerate().for_each(|(i, x)| f(i, x));
+    } else {
+        items.par_iter_mut().enumerate().for_each(|(i, x)| f(i, x));
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn parallel_and_sequential_maps_agree_and_keep_the_order() {
+        let f = |i: usize| (i * 7919) % 1009;
+        assert_eq!(super::map(5000, 1, f), super::map(5000, usize::MAX, f));
+        let g = |i: usize| i.is_multiple_of(3).then_some(i);
+        let (par, seq) = (
+            super::filter_map(5000, 1, g),
+            super::filter_map(5000, usize::MAX, g),
+        );
+        assert_eq!(par, seq);
+        assert!(par.windows(2).all(|w| w[0] < w[1]));
+        let mut a = vec![0usize; 5000];
+        super::for_each_mut(&mut a, 1, |i, x| *x = f(i));
+        assert_eq!(a, super::map(5000, usize::MAX, f));
+    }
+}
