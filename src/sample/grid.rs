@@ -31,13 +31,18 @@ impl Grid {
         self.buckets.entry(key).or_default().push(index);
     }
 
-    /// Calls `f` for every stored index whose cell meets the ball of `radius` around `p`
-    /// (a superset of the points within `radius`), in a deterministic order.
+    /// Whether `f` holds for some stored index whose cell meets the ball of `radius` around
+    /// `p` (a superset of the points within `radius`); stops at the first that does.
     ///
     /// When the ball's bounding box meets more cells than the grid has buckets (a radius of
     /// many cells: an initial Δt far below the step lengths), every bucket is visited
     /// instead, which is cheaper and still a superset.
-    pub(crate) fn for_each_near(&self, p: [f64; 3], radius: f64, mut f: impl FnMut(u32)) {
+    pub(crate) fn any_near(
+        &self,
+        p: [f64; 3],
+        radius: f64,
+        mut f: impl FnMut(u32) -> bool,
+    ) -> bool {
         // Only the cells the ball's bounding box meets: about 1.4³ of them for a radius of
         // 0.7 cells, not the 27 of a cube of radius one cell.
         let radius = radius.max(0.0);
@@ -47,21 +52,19 @@ impl Grid {
             * (hi.1 as f64 - lo.1 as f64 + 1.0)
             * (hi.2 as f64 - lo.2 as f64 + 1.0);
         if radius.is_nan() || cells > self.buckets.len() as f64 {
-            for &i in self.buckets.values().flatten() {
-                f(i);
-            }
-            return;
+            return self.buckets.values().flatten().any(|&i| f(i));
         }
         for x in lo.0..=hi.0 {
             for y in lo.1..=hi.1 {
                 for z in lo.2..=hi.2 {
                     if let Some(bucket) = self.buckets.get(&(x, y, z)) {
-                        for &i in bucket {
-                            f(i);
+                        if bucket.iter().any(|&i| f(i)) {
+                            return true;
                         }
                     }
                 }
             }
         }
+        false
     }
 }

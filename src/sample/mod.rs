@@ -416,11 +416,7 @@ impl<T: Scalar, F: NormalField<T>> Sampler<'_, T, F> {
             Some(_) => radius + (2.0 * drift_q).min(4.0 * len),
             None => radius,
         };
-        let mut hit = false;
-        self.grid.for_each_near(q, reach, |j| {
-            if hit {
-                return;
-            }
+        self.grid.any_near(q, reach, |j| {
             let pj = self.pos[j as usize];
             let d = dist(q, pj);
             let near = match normal {
@@ -432,15 +428,12 @@ impl<T: Scalar, F: NormalField<T>> Sampler<'_, T, F> {
                     across < radius && along.abs() < radius + drift_q + self.drift[j as usize]
                 }
             };
-            if near {
+            near && {
                 let cj = self.chart[j as usize];
                 let dc = ((cj[0] - chart_q[0]).powi(2) + (cj[1] - chart_q[1]).powi(2)).sqrt();
-                if dc > 2.0 * d + len {
-                    hit = true;
-                }
+                dc > 2.0 * d + len
             }
-        });
-        hit
+        })
     }
 
     /// Distance from `q` to curve `k` across it: to the line of its last segment (so that a
