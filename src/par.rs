@@ -1,15 +1,17 @@
 //! Order-preserving parallel maps that stay on the calling thread when the work is small.
 //!
-//! Waking rayon's workers costs tens of microseconds, more than a preset's whole relaxation
-//! sweep, so each map runs in parallel only from `min` items up. Either way the results come
-//! back in index order and are the same: the callers map pure functions.
+//! Handing work to rayon's workers costs tens of microseconds and, while the workers wait
+//! for more, some of a busy machine's time, so each map runs in parallel only from `min`
+//! items up, where the work takes milliseconds. Either way the results come back in index
+//! order and are the same: the callers map pure functions.
 
 use rayon::prelude::*;
 
 /// Items from which a map of cheap work (tens of nanoseconds each: a face test) goes parallel.
 pub(crate) const MIN_CHEAP: usize = 16_384;
-/// Items from which a map of costly work (microseconds each: field evaluations) goes parallel.
-pub(crate) const MIN_COSTLY: usize = 256;
+/// Items from which a map of costly work (microseconds each: field evaluations) goes parallel;
+/// the presets (at most about 1,100 vertices) stay on one thread.
+pub(crate) const MIN_COSTLY: usize = 2048;
 
 /// `(0..n).map(f).collect()`, in parallel when `n >= min`.
 pub(crate) fn map<R: Send>(n: usize, min: usize, f: impl Fn(usize) -> R + Sync + Send) -> Vec<R> {
