@@ -22,19 +22,6 @@ pub(crate) fn map<R: Send>(n: usize, min: usize, f: impl Fn(usize) -> R + Sync +
     }
 }
 
-/// `(0..n).filter_map(f).collect()`, in parallel when `n >= min`.
-pub(crate) fn filter_map<R: Send>(
-    n: usize,
-    min: usize,
-    f: impl Fn(usize) -> Option<R> + Sync + Send,
-) -> Vec<R> {
-    if n < min {
-        (0..n).filter_map(f).collect()
-    } else {
-        (0..n).into_par_iter().filter_map(f).collect()
-    }
-}
-
 /// Calls `f(i, &mut items[i])` for every item, in parallel when there are at least `min`.
 pub(crate) fn for_each_mut<X: Send>(
     items: &mut [X],
@@ -54,13 +41,6 @@ mod tests {
     fn parallel_and_sequential_maps_agree_and_keep_the_order() {
         let f = |i: usize| (i * 7919) % 1009;
         assert_eq!(super::map(5000, 1, f), super::map(5000, usize::MAX, f));
-        let g = |i: usize| i.is_multiple_of(3).then_some(i);
-        let (par, seq) = (
-            super::filter_map(5000, 1, g),
-            super::filter_map(5000, usize::MAX, g),
-        );
-        assert_eq!(par, seq);
-        assert!(par.windows(2).all(|w| w[0] < w[1]));
         let mut a = vec![0usize; 5000];
         super::for_each_mut(&mut a, 1, |i, x| *x = f(i));
         assert_eq!(a, super::map(5000, usize::MAX, f));

@@ -22,7 +22,6 @@ pub(crate) use relax::relax;
 pub use mesh::{Mesh, Provenance};
 
 use crate::error::MeshError;
-use crate::par;
 use crate::sample::{CurveEnd, Samples};
 use crate::scalar::f64x3::{
     cross as cross3, dot as dot3, normalize as normalize3, sub as sub3, FastHash,
@@ -301,15 +300,18 @@ fn chart_triangles(chart: &[[f64; 2]], front: &[u32]) -> Result<Vec<[u32; 3]>, M
         (0.0, Vec::new())
     };
     let inside = |c: [f64; 2]| !use_front || inside_star(chart, front, (a0, &rel), c);
-    // The faces are tested in parallel and kept in spade's order.
-    let faces: Vec<_> = cdt.fixed_inner_faces().collect();
-    let triangles = par::filter_map(faces.len(), par::MIN_CHEAP, |i| {
-        let [a, b, c] = cdt.face(faces[i]).vertices();
-        let (pa, pb, pc) = (a.position(), b.position(), c.position());
-        let centroid = [(pa.x + pb.x + pc.x) / 3.0, (pa.y + pb.y + pc.y) / 3.0];
-        (inside(centroid) && !rounding_sliver(pa, pb, pc))
-            .then(|| [a.data().index, b.data().index, c.data().index])
-    });
+    // One pass in spade's order, straight into the result: beside the triangulation itself
+    // (the peak of memory here), a list of face handles would cost as much as the result.
+    let triangles = cdt
+        .inner_faces()
+        .filter_map(|face| {
+            let [a, b, c] = face.vertices();
+            let (pa, pb, pc) = (a.position(), b.position(), c.position());
+            let centroid = [(pa.x + pb.x + pc.x) / 3.0, (pa.y + pb.y + pc.y) / 3.0];
+            (inside(centroid) && !rounding_sliver(pa, pb, pc))
+                .then(|| [a.data().index, b.data().index, c.data().index])
+        })
+        .collect();
     Ok(triangles)
 }
 
