@@ -76,6 +76,33 @@ fn run_cases(
     (ok.get(), err.get(), marked.get())
 }
 
+/// A property that passes by rejecting everything proves nothing: at least half of the cases
+/// must give a mesh.
+fn assert_most_cases_mesh(ok: usize, err: usize) {
+    assert!(
+        ok >= (ok + err) / 2,
+        "only {ok} of {} cases meshed",
+        ok + err
+    );
+}
+
+/// Random invariants from `invariants` with parameters near either of two presets must give
+/// valid meshes or typed errors, and mostly meshes.
+fn invariants_give_valid_meshes_or_typed_errors(
+    invariants: impl Strategy<Value = Vec<f64>>,
+    presets: [Preset; 2],
+) {
+    let strategy = (
+        invariants,
+        prop_oneof![
+            params_near(presets[0], 20_000),
+            params_near(presets[1], 20_000)
+        ],
+    );
+    let (ok, err, _) = run_cases(256, strategy, |_| true);
+    assert_most_cases_mesh(ok, err);
+}
+
 /// A linear invariant: λ's of either sign around the paper's magnitudes, any angles.
 fn linear_invariant() -> impl Strategy<Value = Vec<f64>> {
     (
@@ -156,35 +183,14 @@ fn params_near(preset: Preset, max_points: usize) -> impl Strategy<Value = MeshP
 
 #[test]
 fn linear_invariants_give_valid_meshes_or_typed_errors() {
-    let strategy = (
-        linear_invariant(),
-        prop_oneof![
-            params_near(Preset::Fig3, 20_000),
-            params_near(Preset::Fig1, 20_000)
-        ],
-    );
-    let (ok, err, _) = run_cases(256, strategy, |_| true);
-    assert!(
-        ok >= (ok + err) / 2,
-        "only {ok} of {} cases meshed",
-        ok + err
-    );
+    invariants_give_valid_meshes_or_typed_errors(linear_invariant(), [Preset::Fig3, Preset::Fig1]);
 }
 
 #[test]
 fn hamiltonian_invariants_give_valid_meshes_or_typed_errors() {
-    let strategy = (
+    invariants_give_valid_meshes_or_typed_errors(
         hamiltonian_invariant(),
-        prop_oneof![
-            params_near(Preset::Fig6, 20_000),
-            params_near(Preset::Fig4, 20_000)
-        ],
-    );
-    let (ok, err, _) = run_cases(256, strategy, |_| true);
-    assert!(
-        ok >= (ok + err) / 2,
-        "only {ok} of {} cases meshed",
-        ok + err
+        [Preset::Fig6, Preset::Fig4],
     );
 }
 
@@ -207,11 +213,7 @@ fn tight_budgets_are_respected() {
     let (ok, err, hit) = run_cases(256, strategy, |run| {
         run.samples.hit_point_budget || run.samples.curves.iter().any(|c| c.end == CurveEnd::Budget)
     });
-    assert!(
-        ok >= (ok + err) / 2,
-        "only {ok} of {} cases meshed",
-        ok + err
-    );
+    assert_most_cases_mesh(ok, err);
     assert!(hit >= ok / 2, "only {hit} of {ok} meshes ran into a budget");
 }
 
