@@ -107,6 +107,37 @@ fn output_is_bit_identical_between_runs() {
 }
 
 #[test]
+fn output_does_not_depend_on_the_number_of_threads() {
+    // An ellipsoid large enough (about 21,000 vertices, 42,000 faces) that the relaxation
+    // and the flips run all their parallel maps, in pools of one and of three threads.
+    let invariant = Invariant::from_numbers(&[1.0, 4.0, 16.0, 0.0, 0.0, 0.0]).unwrap();
+    let field = LieField::<f64>::new(&invariant);
+    let mut params = Preset::Fig3.params();
+    params.p0 = [0.0, 0.0, 0.25];
+    params.beta_min /= 2.0;
+    params.beta_max /= 2.0;
+    params.dt /= 2.0;
+    let in_pool = |threads: usize| {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        pool.install(|| run(&field, &params).unwrap().mesh)
+    };
+    let (one, three) = (in_pool(1), in_pool(3));
+    assert!(
+        one.triangles.len() > 16_384,
+        "{} faces",
+        one.triangles.len()
+    );
+    assert_eq!(one.triangles, three.triangles);
+    let bits =
+        |v: &[[f64; 3]]| -> Vec<[u64; 3]> { v.iter().map(|p| p.map(f64::to_bits)).collect() };
+    assert_eq!(bits(&one.vertices), bits(&three.vertices));
+    assert_eq!(bits(&one.normals), bits(&three.normals));
+}
+
+#[test]
 fn fig3_runs_in_f32_f64_and_dual() {
     let m64 = preset_run::<f64>(Preset::Fig3).mesh;
     let m32 = preset_run::<f32>(Preset::Fig3).mesh;
