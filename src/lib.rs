@@ -68,6 +68,10 @@ pub struct MeshRun<T> {
 
 /// Samples and triangulates the surface of `field` (the whole pipeline), keeping the
 /// intermediate results.
+///
+/// Meshes of a few thousand vertices and more are relaxed and flipped on rayon's current
+/// thread pool (call it inside [`rayon::ThreadPool::install`] to choose the threads); the
+/// result is bit-identical for any number of threads.
 pub fn run<T: Scalar, F: NormalField<T>>(
     field: &F,
     params: &MeshParams,
