@@ -119,11 +119,14 @@ fn fig3_samples() -> Samples<f64> {
 
 /// Found while writing the `triangulate` fuzz target: `triangulate` indexed hand-built
 /// samples without checking them and panicked on an empty curve, a curve naming a missing
-/// point or vectors of different lengths; NaN points became NaN vertices.
+/// point or vectors of different lengths; NaN points became NaN vertices. The NaN angle was
+/// found by the same target (`fuzz/corpus/triangulate/crash-nan-theta-hits-the-chart-cache`):
+/// a per-curve cache of (cos θ, sin θ) keyed on a NaN sentinel gave it the chart position of
+/// the origin, and the mesh kept a vertex with a NaN angle.
 #[test]
 fn triangulating_inconsistent_samples_is_an_error_not_a_panic() {
     type Edit = fn(&mut Samples<f64>);
-    let edits: [(&str, Edit); 5] = [
+    let edits: [(&str, Edit); 7] = [
         ("empty curve", |s| s.curves[2].points.clear()),
         ("missing point", |s| s.curves[0].points.push(1_000_000)),
         ("short normals", |s| {
@@ -131,6 +134,8 @@ fn triangulating_inconsistent_samples_is_an_error_not_a_panic() {
         }),
         ("short provenance", |s| s.provenance.truncate(3)),
         ("NaN point", |s| s.points[5] = Vec3::new(f64::NAN, 0.0, 1.0)),
+        ("NaN angle", |s| s.provenance[0].theta = f64::NAN),
+        ("infinite arc length", |s| s.provenance[7].s = f64::INFINITY),
     ];
     assert!(liemesh::triangulate::triangulate(&fig3_samples(), true, true).is_ok());
     for (what, edit) in edits {

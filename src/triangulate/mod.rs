@@ -74,17 +74,23 @@ pub fn triangulate<T: Scalar>(
     }
     // `Samples::chart`, with each curve's (cos θ, sin θ) computed once: the points of a
     // curve share θ (checked, since hand-built samples need not).
-    let mut dirs: Vec<(f64, [f64; 2])> = vec![(f64::NAN, [0.0; 2]); samples.curves.len()];
+    // No sentinel θ: a NaN θ must give a NaN chart position (which spade rejects), not hit
+    // a cache slot that happens to hold the same NaN.
+    let mut dirs: Vec<Option<(u64, [f64; 2])>> = vec![None; samples.curves.len()];
     let chart: Vec<[f64; 2]> = samples
         .provenance
         .iter()
         .map(|pr| {
-            let mut fresh = (f64::NAN, [0.0; 2]);
-            let (theta, dir) = dirs.get_mut(pr.curve as usize).unwrap_or(&mut fresh);
-            if theta.to_bits() != pr.theta.to_bits() {
-                *theta = pr.theta;
-                *dir = [pr.theta.cos(), pr.theta.sin()];
-            }
+            let mut fresh = None;
+            let slot = dirs.get_mut(pr.curve as usize).unwrap_or(&mut fresh);
+            let dir = match slot {
+                Some((bits, dir)) if *bits == pr.theta.to_bits() => *dir,
+                _ => {
+                    let dir = [pr.theta.cos(), pr.theta.sin()];
+                    *slot = Some((pr.theta.to_bits(), dir));
+                    dir
+                }
+            };
             [pr.s * dir[0], pr.s * dir[1]]
         })
         .collect();
@@ -166,8 +172,9 @@ pub fn triangulate<T: Scalar>(
 
 /// Rejects samples that [`sample`](crate::sample::sample) cannot produce but a caller who
 /// builds [`Samples`] by hand can: vectors of different lengths, curves without points or
-/// naming points that do not exist, and non-finite points or normals (which would end up as
-/// NaN vertices).
+/// naming points that do not exist, non-finite points or normals (which would end up as NaN
+/// vertices) and non-finite arc lengths or angles (which leave a point without a chart
+/// position).
 fn check_samples<T: Scalar>(samples: &Samples<T>) -> Result<(), MeshError> {
     let n = samples.points.len();
     let bad = |what: String| Err(MeshError::Triangulation(what));
@@ -195,6 +202,14 @@ fn check_samples<T: Scalar>(samples: &Samples<T>) -> Result<(), MeshError> {
             "sample point {i} or its normal is not finite: {:?}, {:?}",
             samples.points[i].to_f64(),
             samples.normals[i].to_f64()
+        ));
+    }
+    if let Some((i, pr)) = (samples.provenance.iter().enumerate())
+        .find(|(_, pr)| !(pr.s.is_finite() && pr.theta.is_finite()))
+    {
+        return bad(format!(
+            "sample point {i} has no chart position: its provenance says s = {}, θ = {} (both must be finite)",
+            pr.s, pr.theta
         ));
     }
     Ok(())
