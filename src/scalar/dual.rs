@@ -18,27 +18,12 @@ use std::ops::{Add, AddAssign, Div, DivAssign, Mul, MulAssign, Neg, Rem, Sub, Su
 /// assert_eq!(y.re, 3.0);
 /// assert!((y.eps - 1.0).abs() < 1e-15);
 /// ```
-#[derive(Debug, Default, PartialEq)]
+#[derive(Clone, Debug, Default, PartialEq)]
 pub struct Dual<T> {
     /// The value.
     pub re: T,
     /// The derivative along the seeded direction.
     pub eps: T,
-}
-
-impl<T: Clone> Clone for Dual<T> {
-    #[inline(always)]
-    fn clone(&self) -> Self {
-        Dual {
-            re: self.re.clone(),
-            eps: self.eps.clone(),
-        }
-    }
-    #[inline(always)]
-    fn clone_from(&mut self, source: &Self) {
-        self.re.clone_from(&source.re);
-        self.eps.clone_from(&source.eps);
-    }
 }
 
 impl<T: Scalar> Dual<T> {

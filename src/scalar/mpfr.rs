@@ -20,20 +20,8 @@ use std::ops::{Add, AddAssign, Div, DivAssign, Mul, MulAssign, Neg, Rem, Sub, Su
 /// let back = third * Mpfr::from_f64(3.0) - Mpfr::from_f64(1.0);
 /// assert!(back.abs().to_f64() < 1e-70);
 /// ```
-#[derive(PartialEq, PartialOrd)]
+#[derive(Clone, PartialEq, PartialOrd)]
 pub struct Mpfr<const BITS: u32>(pub Float);
-
-impl<const BITS: u32> Clone for Mpfr<BITS> {
-    #[inline]
-    fn clone(&self) -> Self {
-        Mpfr(self.0.clone())
-    }
-    /// Reuses `self`'s limbs: all values of the type have the same precision.
-    #[inline]
-    fn clone_from(&mut self, source: &Self) {
-        self.0.clone_from(&source.0);
-    }
-}
 
 impl<const BITS: u32> Mpfr<BITS> {
     /// Wraps any value `rug` can convert, rounded to `BITS` bits.
