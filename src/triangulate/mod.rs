@@ -72,28 +72,7 @@ pub fn triangulate<T: Scalar>(
             "only {n} sample point(s); the curves ended right away (check p0, Δt and the terminal conditions)"
         )));
     }
-    // `Samples::chart`, with each curve's (cos θ, sin θ) computed once: the points of a
-    // curve share θ (checked, since hand-built samples need not).
-    // No sentinel θ: a NaN θ must give a NaN chart position (which spade rejects), not hit
-    // a cache slot that happens to hold the same NaN.
-    let mut dirs: Vec<Option<(u64, [f64; 2])>> = vec![None; samples.curves.len()];
-    let chart: Vec<[f64; 2]> = samples
-        .provenance
-        .iter()
-        .map(|pr| {
-            let mut fresh = None;
-            let slot = dirs.get_mut(pr.curve as usize).unwrap_or(&mut fresh);
-            let dir = match slot {
-                Some((bits, dir)) if *bits == pr.theta.to_bits() => *dir,
-                _ => {
-                    let dir = [pr.theta.cos(), pr.theta.sin()];
-                    *slot = Some((pr.theta.to_bits(), dir));
-                    dir
-                }
-            };
-            [pr.s * dir[0], pr.s * dir[1]]
-        })
-        .collect();
+    let chart: Vec<[f64; 2]> = (0..n).map(|i| samples.chart(i)).collect();
     let front = front_polygon(samples, &chart);
     let pos: Vec<[f64; 3]> = samples.points.iter().map(|p| p.to_f64()).collect();
 
