@@ -7,6 +7,7 @@
 //! when it keeps the mesh a consistently oriented 2-manifold whose faces agree with the field
 //! normal; flips that undo a fold (a face against the field normal) come first.
 
+use super::rows_by_corner;
 use crate::par;
 use crate::scalar::f64x3::{cross, dot, sub, FastHash};
 use std::collections::{HashMap, VecDeque};
@@ -102,26 +103,8 @@ impl<'a> HalfEdges<'a> {
         if nh >= NONE as usize {
             return None;
         }
-        // Outgoing half-edges per vertex (CSR).
-        let mut start = vec![0u32; vertices + 1];
-        for t in tri.iter() {
-            for &v in t {
-                *start.get_mut(v as usize + 1)? += 1;
-            }
-        }
-        for v in 0..vertices {
-            start[v + 1] += start[v];
-        }
-        let mut fill: Vec<u32> = start[..vertices].to_vec();
-        let mut outgoing = vec![0u32; nh];
-        for (t, tr) in tri.iter().enumerate() {
-            for (k, &v) in tr.iter().enumerate() {
-                let v = v as usize;
-                outgoing[fill[v] as usize] = (3 * t + k) as u32;
-                fill[v] += 1;
-            }
-        }
-        drop(fill);
+        // Outgoing half-edges per vertex.
+        let (start, outgoing) = rows_by_corner(tri, vertices, |t, k| (3 * t + k) as u32)?;
         // Around each vertex `o`, triangle `i` of its star has the half-edges `o → out_to[i]`
         // and `in_from[i] → o`; the twin of `o → d` is the star's `d → o`. Matching within
         // the star reads each triangle once, and walking it (`i` to the triangle whose

@@ -450,6 +450,35 @@ fn close_hole(
     out
 }
 
+/// Rows by vertex, in triangle order: `value(t, k)` for every corner `k` of every triangle
+/// `t`, filed under the corner's vertex (compressed rows: vertex `v`'s values are
+/// `list[start[v]..start[v + 1]]`). Returns `(start, list)`, or `None` if a corner is not
+/// below `vertices`.
+fn rows_by_corner(
+    triangles: &[[u32; 3]],
+    vertices: usize,
+    value: impl Fn(usize, usize) -> u32,
+) -> Option<(Vec<u32>, Vec<u32>)> {
+    let mut start = vec![0u32; vertices + 1];
+    for t in triangles {
+        for &v in t {
+            *start.get_mut(v as usize + 1)? += 1;
+        }
+    }
+    for v in 0..vertices {
+        start[v + 1] += start[v];
+    }
+    let mut fill: Vec<u32> = start[..vertices].to_vec();
+    let mut list = vec![0u32; start[vertices] as usize];
+    for (t, tr) in triangles.iter().enumerate() {
+        for (k, &v) in tr.iter().enumerate() {
+            list[fill[v as usize] as usize] = value(t, k);
+            fill[v as usize] += 1;
+        }
+    }
+    Some((start, list))
+}
+
 /// A right-handed frame `(f1, f2, n)` whose `n` is the mean of `normals`, or `None` when they
 /// cancel out (or are not finite).
 fn frame_around(normals: impl Iterator<Item = [f64; 3]>) -> Option<[[f64; 3]; 3]> {

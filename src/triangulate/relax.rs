@@ -7,7 +7,7 @@
 //! where they are. Edge flips afterwards restore the surface Delaunay property.
 
 use super::flip::{agreement_at, flip_to_surface_delaunay};
-use super::Mesh;
+use super::{rows_by_corner, Mesh};
 use crate::par;
 use crate::params::MeshParams;
 use crate::sample::Samples;
@@ -38,28 +38,12 @@ pub(crate) fn relax<T: Scalar, F: NormalField<T>>(
             samples.points[i].clone()
         })
         .collect();
-    // Neighbours in CSR form (`adj[start[v]..start[v] + len[v]]`), sorted and deduplicated
-    // for a deterministic sum; boundary vertices are fixed.
-    let mut start = vec![0u32; n + 1];
-    for t in &mesh.triangles {
-        for &a in t {
-            start[a as usize + 1] += 1;
-        }
-    }
-    for v in 0..n {
-        start[v + 1] += start[v];
-    }
-    let mut fill: Vec<u32> = start[..n].to_vec();
-    // Out-neighbours: `b` once in `a`'s list per triangle with the directed edge `a → b`.
-    let mut adj = vec![0u32; start[n] as usize];
-    for t in &mesh.triangles {
-        for k in 0..3 {
-            let (a, b) = (t[k], t[(k + 1) % 3]);
-            adj[fill[a as usize] as usize] = b;
-            fill[a as usize] += 1;
-        }
-    }
-    drop(fill);
+    // Out-neighbours in CSR form (`adj[start[v]..start[v] + len[v]]`): `b` once in `a`'s list
+    // per triangle with the directed edge `a → b`, then sorted and deduplicated for a
+    // deterministic sum; boundary vertices are fixed.
+    let tris = &mesh.triangles;
+    let (start, mut adj) = rows_by_corner(tris, n, |t, k| tris[t][(k + 1) % 3])
+        .expect("the mesh's triangles name its vertices");
     for v in 0..n {
         adj[start[v] as usize..start[v + 1] as usize].sort_unstable();
     }

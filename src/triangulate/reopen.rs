@@ -10,7 +10,8 @@
 
 use super::flip::agreement;
 use super::{
-    dot3, frame_around, point_in_polygon, signed_area, simple_polygon, ChartVertex, EdgeSet,
+    dot3, frame_around, point_in_polygon, rows_by_corner, signed_area, simple_polygon, ChartVertex,
+    EdgeSet,
 };
 use spade::{ConstrainedDelaunayTriangulation, Point2, Triangulation as _};
 use std::collections::{HashMap, HashSet};
@@ -53,10 +54,7 @@ pub(super) fn reclose(
     accept: impl Fn(Vec<[u32; 3]>, &[[u32; 3]]) -> Option<Vec<[u32; 3]>>,
 ) -> Option<Reclosed> {
     let n = pos.len();
-    if triangles.iter().flatten().any(|&v| v as usize >= n) {
-        return None;
-    }
-    let stars = Stars::new(triangles, n);
+    let stars = Stars::new(triangles, n)?;
     let star = |v: u32| stars.at(v);
     // Chart 1's own boundary (the front, with any front edge split at a point on it), as
     // (edge, triangle) pairs: found once, kept apart from the region's edges below.
@@ -174,25 +172,10 @@ struct Stars {
 }
 
 impl Stars {
-    fn new(triangles: &[[u32; 3]], n: usize) -> Self {
-        let mut start = vec![0u32; n + 1];
-        for t in triangles {
-            for &v in t {
-                start[v as usize + 1] += 1;
-            }
-        }
-        for v in 0..n {
-            start[v + 1] += start[v];
-        }
-        let mut fill = start[..n].to_vec();
-        let mut list = vec![0u32; start[n] as usize];
-        for (i, t) in triangles.iter().enumerate() {
-            for &v in t {
-                list[fill[v as usize] as usize] = i as u32;
-                fill[v as usize] += 1;
-            }
-        }
-        Stars { start, list }
+    /// `None` if a triangle names a vertex not below `n`.
+    fn new(triangles: &[[u32; 3]], n: usize) -> Option<Self> {
+        let (start, list) = rows_by_corner(triangles, n, |t, _| t as u32)?;
+        Some(Stars { start, list })
     }
 
     fn at(&self, v: u32) -> &[u32] {
