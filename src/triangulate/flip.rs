@@ -30,12 +30,13 @@ fn delaunay_violation(pa: [f64; 3], pb: [f64; 3], pc: [f64; 3], pd: [f64; 3]) ->
 }
 
 /// Unnormalised face normal.
-fn face_normal(p: &[[f64; 3]], t: [u32; 3]) -> [f64; 3] {
+pub(super) fn face_normal(p: &[[f64; 3]], t: [u32; 3]) -> [f64; 3] {
     let [a, b, c] = t.map(|i| p[i as usize]);
     cross(sub(b, a), sub(c, a))
 }
 
-fn field_normal(n: &[[f64; 3]], t: [u32; 3]) -> [f64; 3] {
+/// Sum of the field normals at a face's corners.
+pub(super) fn field_normal(n: &[[f64; 3]], t: [u32; 3]) -> [f64; 3] {
     let mut s = [0.0; 3];
     for i in t {
         for k in 0..3 {
@@ -283,13 +284,8 @@ impl FlagSet {
         self.0[i / 64] >> (i % 64) & 1 == 1
     }
     #[inline]
-    fn set(&mut self, i: usize, on: bool) {
-        let bit = 1u64 << (i % 64);
-        if on {
-            self.0[i / 64] |= bit;
-        } else {
-            self.0[i / 64] &= !bit;
-        }
+    fn clear(&mut self, i: usize) {
+        self.0[i / 64] &= !(1u64 << (i % 64));
     }
 }
 
@@ -329,11 +325,13 @@ pub(crate) fn flip_to_surface_delaunay(
         let (a, b, slot) = if cursor < slots {
             let (h, t, k) = (cursor as u32, cursor / 3, cursor % 3);
             cursor += 1;
-            let tri = match unread.get(&(t as u32)) {
-                Some(&tri) if k == 2 => unread.remove(&(t as u32)).unwrap_or(tri),
-                Some(&tri) => tri,
-                None => he.tri[t],
+            // The last slot of a triangle is the last read of its saved copy.
+            let saved = if k == 2 {
+                unread.remove(&(t as u32))
+            } else {
+                unread.get(&(t as u32)).copied()
             };
+            let tri = saved.unwrap_or(he.tri[t]);
             let (a, b) = (tri[k], tri[(k + 1) % 3]);
             if a >= b {
                 continue;
@@ -404,8 +402,8 @@ pub(crate) fn flip_to_surface_delaunay(
             }
         }
         he.flip(t1, t2, [a, b, c, d]);
-        folded.set(t1 as usize, false);
-        folded.set(t2 as usize, false);
+        folded.clear(t1 as usize);
+        folded.clear(t2 as usize);
         flips += 1;
         for (x, y) in [(a, d), (d, b), (b, c), (c, a)] {
             queue.push_back((x.min(y), x.max(y)));

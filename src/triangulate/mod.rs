@@ -505,17 +505,9 @@ fn frame_around(normals: impl Iterator<Item = [f64; 3]>) -> Option<[[f64; 3]; 3]
 /// Whether any of `triangles` faces against the field normal at its corners (a closing
 /// triangle across a thin, twisted hole can).
 fn folds(triangles: &[[u32; 3]], pos: &[[f64; 3]], normals: &[[f64; 3]]) -> bool {
-    triangles.iter().any(|t| {
-        let [a, b, c] = t.map(|i| pos[i as usize]);
-        let face = cross3(sub3(b, a), sub3(c, a));
-        let mut g = [0.0; 3];
-        for &i in t {
-            for k in 0..3 {
-                g[k] += normals[i as usize][k];
-            }
-        }
-        dot3(face, g) <= 0.0
-    })
+    triangles
+        .iter()
+        .any(|&t| dot3(flip::face_normal(pos, t), flip::field_normal(normals, t)) <= 0.0)
 }
 
 /// Whether `closing` meets `chart` edge to edge: every directed edge is used once, and every

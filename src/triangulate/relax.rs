@@ -167,11 +167,10 @@ fn keep_orientation<T: Scalar>(
                 let r = reverted_in[i as usize];
                 r != NEVER && r + 1 >= round
             };
-            if round > 0 && !t.iter().any(changed) {
-                continue;
-            }
-            if round > 0 || t.iter().any(|&i| reverted_in[i as usize] == 0) {
+            if t.iter().any(changed) {
                 *a = agreement(&new, t);
+            } else if round > 0 {
+                continue;
             }
             let limit = MIN_AGREEMENT.min(b);
             if *a < limit {
