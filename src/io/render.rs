@@ -1104,24 +1104,7 @@ mod tests {
     use std::collections::HashMap;
 
     fn octahedron() -> Mesh {
-        let vertices = vec![
-            [1.0, 0.0, 0.0],
-            [-1.0, 0.0, 0.0],
-            [0.0, 1.0, 0.0],
-            [0.0, -1.0, 0.0],
-            [0.0, 0.0, 1.0],
-            [0.0, 0.0, -1.0],
-        ];
-        let triangles = vec![
-            [0, 2, 4],
-            [2, 1, 4],
-            [1, 3, 4],
-            [3, 0, 4],
-            [2, 0, 5],
-            [1, 2, 5],
-            [3, 1, 5],
-            [0, 3, 5],
-        ];
+        let (vertices, triangles) = crate::triangulate::octahedron();
         with_normals(vertices, triangles)
     }
 

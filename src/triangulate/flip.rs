@@ -67,6 +67,18 @@ pub(super) fn agreement_at(corners: [[f64; 3]; 3], n: &[[f64; 3]], t: [u32; 3]) 
 /// No half-edge.
 const NONE: u32 = u32::MAX;
 
+/// One triangle of a vertex `o`'s star while the half-edges are built: its half-edges
+/// `o → to` and `from → o`, the latter's index `into`.
+#[derive(Clone, Copy, Default)]
+struct StarEntry {
+    to: u32,
+    from: u32,
+    into: u32,
+}
+
+/// No neighbouring entry in the star.
+const UNLINKED: u32 = u32::MAX;
+
 /// Triangles with the half-edge `h = 3 t + k` running from `tri[t][k]` to `tri[t][k + 1]`, its
 /// opposite half-edge `twin[h]` (or [`NONE`] on the boundary), and one outgoing half-edge per
 /// vertex. Flat arrays instead of a hash map of directed edges: a third of the memory and no
@@ -106,39 +118,58 @@ impl<'a> HalfEdges<'a> {
         }
         // Outgoing half-edges per vertex.
         let (start, outgoing) = rows_by_corner(tri, vertices, |t, k| (3 * t + k) as u32)?;
-        // Around each vertex `o`, triangle `i` of its star has the half-edges `o → out_to[i]`
-        // and `in_from[i] → o`; the twin of `o → d` is the star's `d → o`. Matching within
-        // the star reads each triangle once, and walking it (`i` to the triangle whose
-        // outgoing edge leads to `in_from[i]`) checks that the star is one fan.
+        // Around each vertex `o`, triangle `i` of its star has the half-edges `o → to`
+        // and `from → o` (`into` is the latter's index); the twin of `o → d` is the star's
+        // `d → o`. Matching within the star reads each triangle once, and walking it (`i` to
+        // the triangle whose outgoing edge leads to `from[i]`) checks that the star is one
+        // fan.
         let mut twin = vec![NONE; nh];
         let mut out = vec![NONE; vertices];
-        let (mut out_to, mut in_from, mut in_half) = (Vec::new(), Vec::new(), Vec::new());
+        let mut entries: Vec<StarEntry> = Vec::new();
+        let mut links: Vec<[u32; 2]> = Vec::new();
         for o in 0..vertices {
             let star = &outgoing[start[o] as usize..start[o + 1] as usize];
             let Some(&first) = star.first() else {
                 continue;
             };
             out[o] = first;
-            out_to.clear();
-            in_from.clear();
-            in_half.clear();
-            for &h in star {
+            entries.clear();
+            entries.extend(star.iter().map(|&h| {
                 let t = &tri[(h / 3) as usize];
-                out_to.push(t[((h + 1) % 3) as usize]);
-                in_from.push(t[((h + 2) % 3) as usize]);
-                in_half.push(prev(h));
-            }
-            for (i, &d) in out_to.iter().enumerate() {
-                if d as usize == o || out_to[..i].contains(&d) || in_from[..i].contains(&in_from[i])
-                {
+                StarEntry {
+                    to: t[((h + 1) % 3) as usize],
+                    from: t[((h + 2) % 3) as usize],
+                    into: prev(h),
+                }
+            }));
+            links.clear();
+            links.resize(star.len(), [UNLINKED; 2]);
+            // `links[i] = [predecessor, successor]`: the entries `j` with `from[j] == to[i]`
+            // and `to[j] == from[i]`; both are unique once `to` and `from` each are.
+            for i in 0..entries.len() {
+                let e = entries[i];
+                if e.to as usize == o {
                     return None;
                 }
+                for j in 0..i {
+                    let f = entries[j];
+                    if f.to == e.to || f.from == e.from {
+                        return None;
+                    }
+                    if f.from == e.to {
+                        links[i][0] = j as u32;
+                        links[j][1] = i as u32;
+                    }
+                    if f.to == e.from {
+                        links[i][1] = j as u32;
+                        links[j][0] = i as u32;
+                    }
+                }
             }
-            let successor = |i: usize| out_to.iter().position(|&d| d == in_from[i]);
-            let predecessor = |i: usize| in_from.iter().position(|&x| x == out_to[i]);
             for (i, &h) in star.iter().enumerate() {
-                if let Some(j) = predecessor(i) {
-                    twin[h as usize] = in_half[j];
+                let j = links[i][0];
+                if j != UNLINKED {
+                    twin[h as usize] = entries[j as usize].into;
                 }
             }
             // One fan: walking forward from triangle 0 (and backward, if the fan is open)
@@ -146,7 +177,11 @@ impl<'a> HalfEdges<'a> {
             let mut seen = 1;
             let mut i = 0;
             let mut closed = false;
-            while let Some(j) = successor(i) {
+            loop {
+                let j = links[i][1];
+                if j == UNLINKED {
+                    break;
+                }
                 if j == 0 {
                     closed = true;
                     break;
@@ -155,16 +190,20 @@ impl<'a> HalfEdges<'a> {
                 if seen > star.len() {
                     return None;
                 }
-                i = j;
+                i = j as usize;
             }
             if !closed {
                 let mut i = 0;
-                while let Some(j) = predecessor(i) {
+                loop {
+                    let j = links[i][0];
+                    if j == UNLINKED {
+                        break;
+                    }
                     seen += 1;
                     if seen > star.len() {
                         return None;
                     }
-                    i = j;
+                    i = j as usize;
                 }
             }
             if seen != star.len() {
@@ -325,8 +364,11 @@ pub(crate) fn flip_to_surface_delaunay(
         let (a, b, slot) = if cursor < slots {
             let (h, t, k) = (cursor as u32, cursor / 3, cursor % 3);
             cursor += 1;
-            // The last slot of a triangle is the last read of its saved copy.
-            let saved = if k == 2 {
+            // The last slot of a triangle is the last read of its saved copy (and there is
+            // rarely any copy to look for).
+            let saved = if unread.is_empty() {
+                None
+            } else if k == 2 {
                 unread.remove(&(t as u32))
             } else {
                 unread.get(&(t as u32)).copied()
@@ -410,4 +452,98 @@ pub(crate) fn flip_to_surface_delaunay(
         }
     }
     flips
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::octahedron;
+    use super::*;
+
+    #[test]
+    fn half_edges_of_a_closed_surface_pair_every_edge_with_its_reverse() {
+        let (p, mut t) = octahedron();
+        let he = HalfEdges::new(&mut t, p.len()).expect("a closed 2-manifold");
+        for h in 0..he.twin.len() as u32 {
+            let g = he.twin[h as usize];
+            assert_ne!(g, NONE);
+            assert_eq!(he.twin[g as usize], h);
+            assert_eq!((he.origin(g), he.dest(g)), (he.dest(h), he.origin(h)));
+        }
+        for v in 0..p.len() as u32 {
+            assert_eq!(he.origin(he.out[v as usize]), v);
+        }
+        assert_eq!(he.find(4, 0), Some(2));
+        assert!(he.adjacent(0, 2) && !he.adjacent(0, 1));
+    }
+
+    #[test]
+    fn half_edges_leave_the_boundary_of_an_open_fan_unpaired() {
+        let mut t = vec![[0, 1, 2], [0, 2, 3]];
+        let he = HalfEdges::new(&mut t, 4).expect("an open fan");
+        let unpaired = he.twin.iter().filter(|&&g| g == NONE).count();
+        assert_eq!(unpaired, 4);
+        assert_eq!(he.twin[2], 3);
+        // The walk around 0 sees both triangles, whichever it starts from.
+        assert_eq!((he.find(0, 1), he.find(0, 2)), (Some(0), Some(3)));
+        assert_eq!(he.find(0, 3), None);
+        assert!(he.adjacent(0, 3) && he.adjacent(3, 0) && !he.adjacent(1, 3));
+    }
+
+    #[test]
+    fn half_edges_refuse_a_vertex_whose_triangles_form_two_fans() {
+        // Two triangles touching only at vertex 0 (a bow tie).
+        let mut t = vec![[0, 1, 2], [0, 3, 4]];
+        assert!(HalfEdges::new(&mut t, 5).is_none());
+    }
+
+    #[test]
+    fn half_edges_refuse_a_directed_edge_used_twice() {
+        // Both triangles run 0 → 1: one of them is upside down.
+        let mut t = vec![[0, 1, 2], [0, 1, 3]];
+        assert!(HalfEdges::new(&mut t, 4).is_none());
+    }
+
+    #[test]
+    fn half_edges_refuse_a_triangle_with_a_repeated_corner() {
+        let mut t = vec![[0, 1, 1], [0, 1, 2]];
+        assert!(HalfEdges::new(&mut t, 3).is_none());
+    }
+
+    #[test]
+    fn a_long_diagonal_is_flipped_and_a_short_one_kept() {
+        // A flat rhombus, normal +z: the long diagonal 0–2 faces two obtuse angles.
+        let p = vec![
+            [-2.0, 0.0, 0.0],
+            [0.0, -1.0, 0.0],
+            [2.0, 0.0, 0.0],
+            [0.0, 1.0, 0.0],
+        ];
+        let n = vec![[0.0, 0.0, 1.0]; 4];
+        let mut t = vec![[0, 1, 2], [0, 2, 3]];
+        assert_eq!(flip_to_surface_delaunay(&p, &n, &mut t, 10), 1);
+        let mut edges: Vec<_> = t
+            .iter()
+            .flat_map(|t| (0..3).map(move |k| (t[k], t[(k + 1) % 3])))
+            .collect();
+        edges.sort_unstable();
+        assert!(edges.contains(&(1, 3)) || edges.contains(&(3, 1)));
+        // Now Delaunay: a second pass changes nothing.
+        assert_eq!(flip_to_surface_delaunay(&p, &n, &mut t, 10), 0);
+    }
+
+    #[test]
+    fn flips_leave_a_non_manifold_mesh_alone() {
+        let p = vec![
+            [-2.0, 0.0, 0.0],
+            [0.0, -1.0, 0.0],
+            [2.0, 0.0, 0.0],
+            [0.0, 1.0, 0.0],
+            [0.0, 0.0, 1.0],
+        ];
+        let n = vec![[0.0, 0.0, 1.0]; 5];
+        let mut t = vec![[0, 1, 2], [0, 2, 3], [0, 2, 4]];
+        let before = t.clone();
+        assert_eq!(flip_to_surface_delaunay(&p, &n, &mut t, 10), 0);
+        assert_eq!(t, before);
+    }
 }

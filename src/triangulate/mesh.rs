@@ -44,3 +44,28 @@ pub struct Mesh {
     /// Where each vertex came from.
     pub provenance: Vec<Provenance>,
 }
+
+/// The octahedron with corners ±x, ±y, ±z (vertices 0..6 = +x, −x, +y, −y, +z, −z), faces
+/// counter-clockwise seen from outside: the smallest closed mesh for unit tests.
+#[cfg(test)]
+pub(crate) fn octahedron() -> (Vec<[f64; 3]>, Vec<[u32; 3]>) {
+    let vertices = vec![
+        [1.0, 0.0, 0.0],
+        [-1.0, 0.0, 0.0],
+        [0.0, 1.0, 0.0],
+        [0.0, -1.0, 0.0],
+        [0.0, 0.0, 1.0],
+        [0.0, 0.0, -1.0],
+    ];
+    let triangles = vec![
+        [0, 2, 4],
+        [2, 1, 4],
+        [1, 3, 4],
+        [3, 0, 4],
+        [2, 0, 5],
+        [1, 2, 5],
+        [3, 1, 5],
+        [0, 3, 5],
+    ];
+    (vertices, triangles)
+}

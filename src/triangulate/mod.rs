@@ -19,6 +19,8 @@ mod reopen;
 
 pub(crate) use relax::relax;
 
+#[cfg(test)]
+pub(crate) use mesh::octahedron;
 pub use mesh::{Mesh, Provenance};
 
 use crate::error::MeshError;
