@@ -6,10 +6,32 @@ use std::collections::HashMap;
 
 type Cell = (i32, i32, i32);
 
-/// Point indices bucketed by cubic cells of side `cell`.
+/// The query radius, in cells, that the grid's cell size is tuned to. A query visits about
+/// `(1 + 2ρ)³` cells, most of them empty (the points lie on a surface), and every point of a
+/// patch of surface about `(1 + 2ρ)/ρ` radii wide. A cell lookup (a hash probe, usually a
+/// cache miss) costs about ten candidate points, which puts the cost's flat minimum between
+/// ρ = 0.1 and 0.2 on the sphere and the ellipsoid of the benchmarks.
+const TARGET_REACH: f64 = 0.15;
+
+/// The cell is chosen anew when the mean query radius leaves this factor around
+/// [`TARGET_REACH`] cells.
+const RETUNE_FACTOR: f64 = 1.6;
+
+/// Point indices bucketed by cubic cells of side `1 / inv`.
+///
+/// The cell size starts at a guess and follows the query radii: every time the number of
+/// points doubles, the mean radius asked for since the last review is compared with the cell
+/// and, if they are far apart, all points are filed anew (amortised O(1) per point). Queries
+/// return the same answers whatever the cell size; only their cost depends on it.
 pub(crate) struct Grid {
     inv: f64,
     buckets: HashMap<Cell, Vec<u32>, FastHash>,
+    /// Points filed.
+    len: usize,
+    /// The number of points at which the cell size is next reviewed.
+    next_review: usize,
+    /// Sum of the query radii (in cells) and number of queries since the last review.
+    reach: std::cell::Cell<(f64, u32)>,
 }
 
 impl Grid {
@@ -17,6 +39,9 @@ impl Grid {
         Grid {
             inv: 1.0 / cell,
             buckets: HashMap::default(),
+            len: 0,
+            next_review: 256,
+            reach: std::cell::Cell::new((0.0, 0)),
         }
     }
 
@@ -26,9 +51,41 @@ impl Grid {
         (k(p[0]), k(p[1]), k(p[2]))
     }
 
-    pub(crate) fn insert(&mut self, p: [f64; 3], index: u32) {
+    /// Files point `index` at `p`. `positions` are all points filed so far and this one
+    /// (`positions[i]` for index `i`): the grid refiles them when it changes its cell size.
+    pub(crate) fn insert(&mut self, p: [f64; 3], index: u32, positions: &[[f64; 3]]) {
         let key = self.key(p);
         self.buckets.entry(key).or_default().push(index);
+        self.len += 1;
+        if self.len >= self.next_review {
+            self.next_review = 2 * self.len;
+            self.review(positions);
+        }
+    }
+
+    /// Refiles every point with a cell of `TARGET_REACH` mean query radii, if the current
+    /// cell is more than [`RETUNE_FACTOR`] off it.
+    fn review(&mut self, positions: &[[f64; 3]]) {
+        let (sum, queries) = self.reach.replace((0.0, 0));
+        if queries == 0 || positions.len() != self.len {
+            return;
+        }
+        let mean = sum / f64::from(queries);
+        let off = mean / TARGET_REACH;
+        if (1.0 / RETUNE_FACTOR..=RETUNE_FACTOR).contains(&off) || !(off.is_finite() && off > 0.0) {
+            return;
+        }
+        // `mean` is in cells: the new cell is `mean / TARGET_REACH` old cells.
+        let inv = self.inv / off;
+        if !(inv.is_finite() && inv > 0.0) {
+            return;
+        }
+        self.inv = inv;
+        self.buckets.clear();
+        for (i, &p) in positions.iter().enumerate() {
+            let key = self.key(p);
+            self.buckets.entry(key).or_default().push(i as u32);
+        }
     }
 
     /// Whether `f` holds for some stored index whose cell meets the ball of `radius` around
@@ -46,6 +103,10 @@ impl Grid {
         // Only the cells the ball's bounding box meets: about 1.4³ of them for a radius of
         // 0.7 cells, not the 27 of a cube of radius one cell.
         let radius = radius.max(0.0);
+        let (sum, queries) = self.reach.get();
+        if radius.is_finite() && queries < u32::MAX {
+            self.reach.set((sum + radius * self.inv, queries + 1));
+        }
         let lo = self.key([p[0] - radius, p[1] - radius, p[2] - radius]);
         let hi = self.key([p[0] + radius, p[1] + radius, p[2] + radius]);
         let cells = (hi.0 as f64 - lo.0 as f64 + 1.0)
@@ -66,5 +127,92 @@ impl Grid {
             }
         }
         false
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Deterministic points on the unit sphere.
+    fn sphere_points(n: usize) -> Vec<[f64; 3]> {
+        let mut state = 0x2545_F491_4F6C_DD1D_u64;
+        let mut uniform = move || {
+            state = state
+                .wrapping_mul(6_364_136_223_846_793_005)
+                .wrapping_add(1_442_695_040_888_963_407);
+            (state >> 11) as f64 / (1u64 << 53) as f64
+        };
+        (0..n)
+            .map(|_| {
+                let z = 2.0 * uniform() - 1.0;
+                let phi = std::f64::consts::TAU * uniform();
+                let r = (1.0 - z * z).sqrt();
+                [r * phi.cos(), r * phi.sin(), z]
+            })
+            .collect()
+    }
+
+    fn dist(a: [f64; 3], b: [f64; 3]) -> f64 {
+        ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2) + (a[2] - b[2]).powi(2)).sqrt()
+    }
+
+    /// Files `points` one by one, asking a query of `radius` around each before it is filed.
+    fn filled(cell: f64, points: &[[f64; 3]], radius: f64) -> Grid {
+        let mut grid = Grid::new(cell);
+        for (i, &p) in points.iter().enumerate() {
+            grid.any_near(p, radius, |_| false);
+            grid.insert(p, i as u32, &points[..=i]);
+        }
+        grid
+    }
+
+    #[test]
+    fn queries_see_every_point_within_the_radius_whatever_the_cell() {
+        let points = sphere_points(3000);
+        let queries = sphere_points(3100);
+        for cell in [1e-3, 0.05, 0.3, 5.0] {
+            let grid = filled(cell, &points, 0.04);
+            for (k, &q) in queries[3000..].iter().enumerate() {
+                let radius = [0.0, 0.01, 0.05, 0.2][k % 4];
+                let mut seen = vec![false; points.len()];
+                grid.any_near(q, radius, |j| {
+                    seen[j as usize] = true;
+                    false
+                });
+                for (j, &p) in points.iter().enumerate() {
+                    assert!(
+                        seen[j] || dist(p, q) > radius,
+                        "cell {cell}: point {j} missed"
+                    );
+                }
+                let hit = grid.any_near(q, radius, |j| dist(points[j as usize], q) <= radius);
+                let want = points.iter().any(|&p| dist(p, q) <= radius);
+                assert_eq!(hit, want, "cell {cell}, radius {radius}");
+            }
+        }
+    }
+
+    #[test]
+    fn the_cell_follows_the_query_radii() {
+        let points = sphere_points(4000);
+        for (cell, radius) in [(1e-3, 0.02), (2.0, 0.02), (0.02, 0.002)] {
+            let grid = filled(cell, &points, radius);
+            let reach = radius * grid.inv;
+            assert!(
+                (TARGET_REACH / RETUNE_FACTOR..=TARGET_REACH * RETUNE_FACTOR).contains(&reach),
+                "started at {cell}: queries of {radius} span {reach} cells"
+            );
+        }
+    }
+
+    #[test]
+    fn a_grid_without_queries_keeps_its_cell() {
+        let points = sphere_points(1000);
+        let mut grid = Grid::new(0.25);
+        for (i, &p) in points.iter().enumerate() {
+            grid.insert(p, i as u32, &points[..=i]);
+        }
+        assert_eq!(grid.inv, 4.0);
     }
 }

@@ -193,7 +193,7 @@ pub fn sample<T: Scalar, F: NormalField<T>>(
     if params.mode == Mode::Paper {
         s.drift.push(0.0);
     }
-    s.grid.insert(params.p0, 0);
+    s.grid.insert(params.p0, 0, &s.pos);
     let n = thetas.len() as u32;
     for (j, &theta) in thetas.iter().enumerate() {
         let j = j as u32;
@@ -353,7 +353,7 @@ impl<T: Scalar, F: NormalField<T>> Sampler<'_, T, F> {
         self.out.curves[ci].points.push(index);
         self.pos.push(q);
         self.chart.push(chart_q);
-        self.grid.insert(q, index);
+        self.grid.insert(q, index, &self.pos);
         if !self.drift.is_empty() {
             self.drift.push(drift);
             self.max_drift = self.max_drift.max(drift);
@@ -425,7 +425,11 @@ impl<T: Scalar, F: NormalField<T>> Sampler<'_, T, F> {
                     let e = sub(q, pj);
                     let along = dot(e, n);
                     let across = (d * d - along * along).max(0.0).sqrt();
-                    across < radius && along.abs() < radius + drift_q + self.drift[j as usize]
+                    // Only points within `reach`, so that the answer does not depend on
+                    // how the grid happens to bucket the points beyond it.
+                    d <= reach
+                        && across < radius
+                        && along.abs() < radius + drift_q + self.drift[j as usize]
                 }
             };
             near && {
@@ -562,7 +566,7 @@ impl<T: Scalar, F: NormalField<T>> Sampler<'_, T, F> {
         });
         self.pos.push(start_f);
         self.chart.push(chart);
-        self.grid.insert(start_f, index);
+        self.grid.insert(start_f, index, &self.pos);
         if !self.drift.is_empty() {
             self.drift.push(drift);
         }
