@@ -136,21 +136,8 @@ mod tests {
 
     /// Deterministic points on the unit sphere.
     fn sphere_points(n: usize) -> Vec<[f64; 3]> {
-        let mut state = 0x2545_F491_4F6C_DD1D_u64;
-        let mut uniform = move || {
-            state = state
-                .wrapping_mul(6_364_136_223_846_793_005)
-                .wrapping_add(1_442_695_040_888_963_407);
-            (state >> 11) as f64 / (1u64 << 53) as f64
-        };
-        (0..n)
-            .map(|_| {
-                let z = 2.0 * uniform() - 1.0;
-                let phi = std::f64::consts::TAU * uniform();
-                let r = (1.0 - z * z).sqrt();
-                [r * phi.cos(), r * phi.sin(), z]
-            })
-            .collect()
+        let mut rng = crate::audit::XorShift64::new(3);
+        (0..n).map(|_| rng.unit_vector()).collect()
     }
 
     fn dist(a: [f64; 3], b: [f64; 3]) -> f64 {

@@ -295,7 +295,17 @@ fn chart_triangles(chart: &[[f64; 2]], front: &[u32]) -> Result<Vec<[u32; 3]>, M
     } else {
         (0.0, Vec::new())
     };
-    let inside = |c: [f64; 2]| !use_front || inside_star(chart, front, (a0, &rel), c);
+    // The origin lies on the inner side of every front edge's line, so a point nearer to it
+    // than the nearest such line is inside whichever wedge the angle search picks: most
+    // centroids are settled without an arctangent.
+    let disk = if use_front {
+        inner_disk(chart, front)
+    } else {
+        0.0
+    };
+    let inside = |c: [f64; 2]| {
+        !use_front || c[0] * c[0] + c[1] * c[1] < disk || inside_star(chart, front, (a0, &rel), c)
+    };
     // One pass in spade's order, straight into the result: beside the triangulation itself
     // (the peak of memory here), a list of face handles would cost as much as the result.
     let triangles = cdt
@@ -316,7 +326,11 @@ fn chart_triangles(chart: &[[f64; 2]], front: &[u32]) -> Result<Vec<[u32; 3]>, M
 /// exactly 0), which spade keeps as a hull triangle but which has no area in space.
 fn rounding_sliver(a: Point2<f64>, b: Point2<f64>, c: Point2<f64>) -> bool {
     let (u, v) = ([b.x - a.x, b.y - a.y], [c.x - a.x, c.y - a.y]);
-    cross2(u, v).abs() <= 1e-12 * u[0].hypot(u[1]) * v[0].hypot(v[1])
+    let area = cross2(u, v).abs();
+    // |u|₁ ≥ |u|, so a triangle clear of this looser bound (1 % over it, far above the
+    // rounding of either) is no sliver, and the two `hypot`s are spared.
+    let loose = 1.01e-12 * (u[0].abs() + u[1].abs()) * (v[0].abs() + v[1].abs());
+    area <= loose && area <= 1e-12 * u[0].hypot(u[1]) * v[0].hypot(v[1])
 }
 
 /// Whether the polygon is star-shaped about the origin with vertices in counter-clockwise
@@ -334,6 +348,37 @@ fn star_shaped(chart: &[[f64; 2]], front: &[u32]) -> bool {
         total += span;
     }
     (total - std::f64::consts::TAU).abs() < 1e-6
+}
+
+/// A squared radius about the origin within which every point is on the inner side of every
+/// front edge's line, or 0; the polygon must be star-shaped about the origin (see
+/// [`star_shaped`]).
+///
+/// A point at `|c| < r` from the origin, `r` the distance to the nearest edge line, is
+/// inside edge `(a, b)` by `cross(b − a, c − a) ≥ (r − |c|) |b − a|`. The radius is kept
+/// 10⁻⁶ (relative) inside `r`, and edges whose line passes within 10⁻⁶ |a| of the origin
+/// turn the shortcut off, so that this margin dwarfs the rounding of the cross product.
+fn inner_disk(chart: &[[f64; 2]], front: &[u32]) -> f64 {
+    let m = front.len();
+    let mut nearest = f64::INFINITY;
+    for i in 0..m {
+        let a = chart[front[i] as usize];
+        let b = chart[front[(i + 1) % m] as usize];
+        let e = sub2(b, a);
+        // Distance² from the origin to the edge's line: cross(e, −a)² / |e|².
+        let d = cross2(e, [-a[0], -a[1]]);
+        let ee = e[0] * e[0] + e[1] * e[1];
+        let line = d * d / ee;
+        if !(d > 0.0 && ee > 0.0 && line >= 1e-12 * (a[0] * a[0] + a[1] * a[1])) {
+            return 0.0;
+        }
+        nearest = nearest.min(line);
+    }
+    if nearest.is_finite() {
+        nearest * (1.0 - 1e-6)
+    } else {
+        0.0
+    }
 }
 
 /// Polar angle of `p` in `[0, 2π)`.
@@ -671,4 +716,78 @@ fn assemble<T: Scalar>(samples: &Samples<T>, pos: &[[f64; 3]], triangles: &[[u32
         })
         .collect();
     mesh
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::audit::XorShift64;
+
+    /// A polygon star-shaped about the origin: `m` vertices at increasing angles.
+    fn star(rng: &mut XorShift64, m: usize, wobble: f64) -> Vec<[f64; 2]> {
+        let mut angles: Vec<f64> = (0..m)
+            .map(|i| (i as f64 + rng.uniform(0.0, 0.9)) * std::f64::consts::TAU / m as f64)
+            .collect();
+        angles.sort_by(f64::total_cmp);
+        angles
+            .iter()
+            .map(|&a| {
+                let r = 1.0 + rng.uniform(-wobble, wobble);
+                [r * a.cos(), r * a.sin()]
+            })
+            .collect()
+    }
+
+    #[test]
+    fn points_in_the_inner_disk_are_inside_the_star() {
+        let mut rng = XorShift64::new(11);
+        for trial in 0..200 {
+            let m = 3 + trial % 40;
+            let chart = star(&mut rng, m, [0.0, 0.3, 0.9][trial % 3]);
+            let front: Vec<u32> = (0..m as u32).collect();
+            if !star_shaped(&chart, &front) {
+                continue;
+            }
+            let disk = inner_disk(&chart, &front);
+            let angles = star_angles(&chart, &front);
+            for _ in 0..200 {
+                let r = disk.sqrt() * rng.uniform(0.0, 1.0);
+                let a = rng.uniform(0.0, std::f64::consts::TAU);
+                let c = [r * a.cos(), r * a.sin()];
+                if c[0] * c[0] + c[1] * c[1] < disk {
+                    assert!(inside_star(&chart, &front, (angles.0, &angles.1), c));
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn an_edge_through_the_origin_turns_the_inner_disk_off() {
+        // The edge from (1, 0) to (−1, 1e-9) passes 5e-10 from the origin.
+        let chart = [[1.0, 0.0], [-1.0, 1e-9], [0.0, -1.0]];
+        assert_eq!(inner_disk(&chart, &[0, 1, 2]), 0.0);
+    }
+
+    #[test]
+    fn slivers_are_found_as_by_the_exact_bound() {
+        let exact = |a: Point2<f64>, b: Point2<f64>, c: Point2<f64>| {
+            let (u, v) = ([b.x - a.x, b.y - a.y], [c.x - a.x, c.y - a.y]);
+            cross2(u, v).abs() <= 1e-12 * u[0].hypot(u[1]) * v[0].hypot(v[1])
+        };
+        let mut rng = XorShift64::new(5);
+        let mut slivers = 0;
+        for _ in 0..20_000 {
+            let a = Point2::new(rng.uniform(-1.0, 1.0), rng.uniform(-1.0, 1.0));
+            let d = [rng.uniform(-1.0, 1.0), rng.uniform(-1.0, 1.0)];
+            // Off the line through a along d by a relative amount from 1e-16 to 1e-8.
+            let off = 10f64.powf(rng.uniform(-16.0, -8.0));
+            let t = rng.uniform(-2.0, 2.0);
+            let b = Point2::new(a.x + d[0], a.y + d[1]);
+            let c = Point2::new(a.x + t * d[0] - off * d[1], a.y + t * d[1] + off * d[0]);
+            let want = exact(a, b, c);
+            slivers += usize::from(want);
+            assert_eq!(rounding_sliver(a, b, c), want, "{a:?} {b:?} {c:?}");
+        }
+        assert!(slivers > 1000, "{slivers}");
+    }
 }
