@@ -56,8 +56,10 @@ pub(crate) fn relax<T: Scalar, F: NormalField<T>>(
     let mut fixed = vec![false; n];
     for a in 0..n as u32 {
         let list = &adj[start[a as usize] as usize..start[a as usize + 1] as usize];
-        for (k, &b) in list.iter().enumerate() {
-            if (k == 0 || list[k - 1] != b) && uses(a, b) + uses(b, a) != 2 {
+        // `a → b` is used as often as `b` repeats in `a`'s sorted list.
+        for run in list.chunk_by(|x, y| x == y) {
+            let b = run[0];
+            if run.len() + uses(b, a) != 2 {
                 fixed[a as usize] = true;
                 fixed[b as usize] = true;
             }
