@@ -100,6 +100,43 @@ fn open_presets_are_discs() {
 }
 
 #[test]
+fn relaxation_moves_interior_vertices_but_not_the_boundary_or_p0() {
+    for p in [Preset::Fig4, Preset::Fig5, Preset::Fig6] {
+        let r = preset_run::<f64>(p);
+        let m = &r.mesh;
+        // Directed edges without their reverse are the boundary.
+        let mut directed = std::collections::HashSet::new();
+        for t in &m.triangles {
+            for k in 0..3 {
+                directed.insert((t[k], t[(k + 1) % 3]));
+            }
+        }
+        let mut on_boundary = vec![false; m.vertices.len()];
+        for &(a, b) in &directed {
+            if !directed.contains(&(b, a)) {
+                on_boundary[a as usize] = true;
+                on_boundary[b as usize] = true;
+            }
+        }
+        let (mut moved, mut interior) = (0, 0);
+        for (v, pr) in m.provenance.iter().enumerate() {
+            let i = r.samples.curves[pr.curve as usize].points[pr.step as usize] as usize;
+            let sampled = r.samples.points[i].to_f64();
+            if on_boundary[v] || (pr.curve == 0 && pr.step == 0) {
+                assert_eq!(m.vertices[v], sampled, "{p}: vertex {v} moved");
+            } else {
+                interior += 1;
+                moved += usize::from(m.vertices[v] != sampled);
+            }
+        }
+        assert!(
+            on_boundary.iter().any(|&b| b) && moved * 10 > interior * 9,
+            "{p}: {moved} of {interior} interior vertices moved"
+        );
+    }
+}
+
+#[test]
 fn output_is_bit_identical_between_runs() {
     for p in Preset::ALL {
         assert_eq!(preset_run::<f64>(p).mesh, preset_run::<f64>(p).mesh, "{p}");
