@@ -51,11 +51,15 @@ impl Grid {
         (k(p[0]), k(p[1]), k(p[2]))
     }
 
-    /// Files point `index` at `p`. `positions` are all points filed so far and this one
-    /// (`positions[i]` for index `i`): the grid refiles them when it changes its cell size.
-    pub(crate) fn insert(&mut self, p: [f64; 3], index: u32, positions: &[[f64; 3]]) {
+    /// Files the last of `positions` (index `positions.len() − 1`); the others must have been
+    /// filed before, in order. The grid refiles them all when it changes its cell size.
+    pub(crate) fn push(&mut self, positions: &[[f64; 3]]) {
+        let Some((&p, _)) = positions.split_last() else {
+            return;
+        };
+        debug_assert_eq!(positions.len(), self.len + 1, "points are filed in order");
         let key = self.key(p);
-        self.buckets.entry(key).or_default().push(index);
+        self.buckets.entry(key).or_default().push(self.len as u32);
         self.len += 1;
         if self.len >= self.next_review {
             self.next_review = 2 * self.len;
@@ -67,7 +71,7 @@ impl Grid {
     /// cell is more than [`RETUNE_FACTOR`] off it.
     fn review(&mut self, positions: &[[f64; 3]]) {
         let (sum, queries) = self.reach.replace((0.0, 0));
-        if queries == 0 || positions.len() != self.len {
+        if queries == 0 {
             return;
         }
         let mean = sum / f64::from(queries);
@@ -100,8 +104,8 @@ impl Grid {
         radius: f64,
         mut f: impl FnMut(u32) -> bool,
     ) -> bool {
-        // Only the cells the ball's bounding box meets: about 1.4³ of them for a radius of
-        // 0.7 cells, not the 27 of a cube of radius one cell.
+        // Only the cells the ball's bounding box meets: about (1 + 2ρ)³ for a radius of ρ
+        // cells.
         let radius = radius.max(0.0);
         let (sum, queries) = self.reach.get();
         if radius.is_finite() && queries < u32::MAX {
@@ -149,7 +153,7 @@ mod tests {
         let mut grid = Grid::new(cell);
         for (i, &p) in points.iter().enumerate() {
             grid.any_near(p, radius, |_| false);
-            grid.insert(p, i as u32, &points[..=i]);
+            grid.push(&points[..=i]);
         }
         grid
     }
@@ -197,8 +201,8 @@ mod tests {
     fn a_grid_without_queries_keeps_its_cell() {
         let points = sphere_points(1000);
         let mut grid = Grid::new(0.25);
-        for (i, &p) in points.iter().enumerate() {
-            grid.insert(p, i as u32, &points[..=i]);
+        for i in 0..points.len() {
+            grid.push(&points[..=i]);
         }
         assert_eq!(grid.inv, 4.0);
     }

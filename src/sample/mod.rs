@@ -193,7 +193,7 @@ pub fn sample<T: Scalar, F: NormalField<T>>(
     if params.mode == Mode::Paper {
         s.drift.push(0.0);
     }
-    s.grid.insert(params.p0, 0, &s.pos);
+    s.grid.push(&s.pos);
     let n = thetas.len() as u32;
     for (j, &theta) in thetas.iter().enumerate() {
         let j = j as u32;
@@ -353,7 +353,7 @@ impl<T: Scalar, F: NormalField<T>> Sampler<'_, T, F> {
         self.out.curves[ci].points.push(index);
         self.pos.push(q);
         self.chart.push(chart_q);
-        self.grid.insert(q, index, &self.pos);
+        self.grid.push(&self.pos);
         if !self.drift.is_empty() {
             self.drift.push(drift);
             self.max_drift = self.max_drift.max(drift);
@@ -566,7 +566,7 @@ impl<T: Scalar, F: NormalField<T>> Sampler<'_, T, F> {
         });
         self.pos.push(start_f);
         self.chart.push(chart);
-        self.grid.insert(start_f, index, &self.pos);
+        self.grid.push(&self.pos);
         if !self.drift.is_empty() {
             self.drift.push(drift);
         }
