@@ -166,10 +166,14 @@ impl<'a> HalfEdges<'a> {
                     }
                 }
             }
+            let linked = |i: usize, side: usize| {
+                let j = links[i][side];
+                (j != UNLINKED).then_some(j as usize)
+            };
+            let (predecessor, successor) = (|i| linked(i, 0), |i| linked(i, 1));
             for (i, &h) in star.iter().enumerate() {
-                let j = links[i][0];
-                if j != UNLINKED {
-                    twin[h as usize] = entries[j as usize].into;
+                if let Some(j) = predecessor(i) {
+                    twin[h as usize] = entries[j].into;
                 }
             }
             // One fan: walking forward from triangle 0 (and backward, if the fan is open)
@@ -177,11 +181,7 @@ impl<'a> HalfEdges<'a> {
             let mut seen = 1;
             let mut i = 0;
             let mut closed = false;
-            loop {
-                let j = links[i][1];
-                if j == UNLINKED {
-                    break;
-                }
+            while let Some(j) = successor(i) {
                 if j == 0 {
                     closed = true;
                     break;
@@ -190,20 +190,16 @@ impl<'a> HalfEdges<'a> {
                 if seen > star.len() {
                     return None;
                 }
-                i = j as usize;
+                i = j;
             }
             if !closed {
                 let mut i = 0;
-                loop {
-                    let j = links[i][0];
-                    if j == UNLINKED {
-                        break;
-                    }
+                while let Some(j) = predecessor(i) {
                     seen += 1;
                     if seen > star.len() {
                         return None;
                     }
-                    i = j as usize;
+                    i = j;
                 }
             }
             if seen != star.len() {
