@@ -1,4 +1,5 @@
-//! `liemesh bench --tiny --json` prints the expected keys with positive numbers.
+//! `liemesh bench --tiny --json` prints the expected keys with positive numbers, and judges the
+//! targets its workloads cover.
 
 use std::process::Command;
 
@@ -42,5 +43,31 @@ fn bench_json_has_keys_and_positive_numbers() {
     for key in ["dual_over_f64", "sphere_scaling", "ellipsoid_scaling"] {
         let x = v["ratios"][key].as_f64().unwrap_or(-1.0);
         assert!(x > 0.0 && x.is_finite(), "{key} = {x}");
+    }
+    // Each target the run covers is judged: a limit, a verdict, and a measured value that is
+    // a positive number or, for an unreached fidelity limit, null.
+    let targets = v["targets"].as_array().expect("targets");
+    let names: Vec<&str> = targets
+        .iter()
+        .map(|t| t["target"].as_str().unwrap())
+        .collect();
+    assert!(
+        names.iter().any(|n| n.starts_with("fig1..fig6")),
+        "{names:?}"
+    );
+    assert!(
+        names.iter().any(|n| n.starts_with("Dual<f64>")),
+        "{names:?}"
+    );
+    for t in targets {
+        assert!(t["limit"].as_f64().unwrap() > 0.0, "{t}");
+        let met = t["met"].as_bool().expect("a verdict");
+        match t["measured"].as_f64() {
+            Some(x) => {
+                assert!(x > 0.0 && x.is_finite(), "{t}");
+                assert_eq!(met, x <= t["limit"].as_f64().unwrap(), "{t}");
+            }
+            None => assert!(t["measured"].is_null() && !met, "{t}"),
+        }
     }
 }

@@ -159,6 +159,20 @@ pub struct Ratios {
     pub ellipsoid_scaling: f64,
 }
 
+/// One of issue 6's targets, judged on this run.
+#[derive(Debug, Clone, Serialize)]
+pub struct TargetRow {
+    /// What is measured, with its unit.
+    pub target: String,
+    /// The worst value of this run over the workloads the target covers (NaN, `null` in
+    /// JSON, when there is nothing to time: the fidelity limit was not reached).
+    pub measured: f64,
+    /// The limit (`measured ≤ limit` meets it, except where `met` says otherwise).
+    pub limit: f64,
+    /// Whether this run meets the target.
+    pub met: bool,
+}
+
 /// The whole report.
 #[derive(Debug, Clone, Serialize)]
 pub struct BenchReport {
@@ -173,6 +187,79 @@ pub struct BenchReport {
     /// Peak memory of the largest sphere and ellipsoid meshes (empty where the platform cannot
     /// tell).
     pub memory: Vec<MemoryRow>,
+    /// Issue 6's targets that this run's workloads cover, each judged (`liemesh batch`'s
+    /// speed-up is measured by running it, not here).
+    pub targets: Vec<TargetRow>,
+}
+
+/// Judges the targets that `report`'s workloads cover.
+fn targets(report: &BenchReport) -> Vec<TargetRow> {
+    let mut out = Vec::new();
+    let mut judge = |target: &str, measured: f64, limit: f64| {
+        out.push(TargetRow {
+            target: target.to_string(),
+            measured,
+            limit,
+            met: measured <= limit,
+        });
+    };
+    let worst = |values: &mut dyn Iterator<Item = f64>| values.fold(f64::NAN, f64::max);
+    let is_preset = |r: &&WorkloadRow| Preset::ALL.iter().any(|p| p.name() == r.workload);
+    let presets = worst(
+        &mut report
+            .rows
+            .iter()
+            .filter(is_preset)
+            .map(|r| r.total_ns_per_tri * r.triangles as f64 / 1e6),
+    );
+    judge("fig1..fig6 end to end, ms", presets, 5.0);
+    let large = |r: &&WorkloadRow| r.workload.ends_with("-1e5") || r.workload.ends_with("-1e6");
+    if report.rows.iter().any(|r| large(&r)) {
+        let ns = worst(&mut report.rows.iter().filter(large).map(|r| r.total_ns_per_tri));
+        judge("end to end at 10^5 and 10^6, ns per triangle", ns, 350.0);
+        let spd = worst(&mut report.rows.iter().filter(large).map(|r| r.total_over_spade));
+        judge("end to end at 10^5 and 10^6 / spade's bulk load", spd, 1.5);
+    }
+    let r = &report.ratios;
+    let has = |tag: &str| report.rows.iter().any(|r| r.workload.ends_with(tag));
+    if has("-1e4") && has("-1e6") {
+        judge(
+            "ns per triangle at 10^6 / at 10^4",
+            r.sphere_scaling.max(r.ellipsoid_scaling),
+            1.5,
+        );
+    }
+    judge("Dual<f64> / f64 sampling", r.dual_over_f64, 3.0);
+    if let Some(m) = r.mpfr256_over_f64 {
+        judge("Mpfr<256> / f64 sampling", m, 100.0);
+    }
+    // Not reached at all: no time to judge (NaN, `null` in JSON).
+    for f in &report.fidelity {
+        out.push(TargetRow {
+            target: format!(
+                "{}: coarsest mesh within {FIDELITY_LIMIT_DEG}° normal error, ms",
+                f.workload
+            ),
+            measured: if f.reached { f.ms } else { f64::NAN },
+            limit: 2.0,
+            met: f.reached && f.ms <= 2.0,
+        });
+    }
+    let million: Vec<&MemoryRow> = report
+        .memory
+        .iter()
+        .filter(|m| m.workload.ends_with("-1e6"))
+        .collect();
+    if !million.is_empty() {
+        let mb = worst(&mut million.iter().map(|m| m.peak_mb));
+        out.push(TargetRow {
+            target: "peak memory of a 10^6-triangle mesh, MB".to_string(),
+            measured: mb,
+            limit: MEMORY_BUDGET_MB,
+            met: mb < MEMORY_BUDGET_MB,
+        });
+    }
+    out
 }
 
 /// Parameters for the sphere (`ellipsoid = false`) or the ellipsoid `(1, 4, 16, 0, 0, 0)`
@@ -329,7 +416,9 @@ fn time_sampling<T: Scalar, F: NormalField<T>>(
 /// Runs every workload and collects the report.
 pub fn measure(args: &BenchArgs) -> Result<BenchReport, CliError> {
     let mut rows = Vec::new();
-    let repeats = if args.tiny { 3 } else { 5 };
+    // A preset takes a few ms: 25 repeats cost a tenth of a second each and steady the
+    // median on a busy machine.
+    let repeats = if args.tiny { 3 } else { 25 };
     for preset in Preset::ALL {
         let field_inv = preset.invariant();
         rows.push(time_workload(
@@ -408,13 +497,16 @@ pub fn measure(args: &BenchArgs) -> Result<BenchReport, CliError> {
         .into_iter()
         .filter_map(|ellipsoid| memory_row(ellipsoid, target, tag))
         .collect();
-    Ok(BenchReport {
+    let mut report = BenchReport {
         rows,
         fig6_sampling_ms: fig6,
         fidelity,
         ratios,
         memory,
-    })
+        targets: Vec::new(),
+    };
+    report.targets = targets(&report);
+    Ok(report)
 }
 
 /// `liemesh bench`.
@@ -499,6 +591,29 @@ pub fn run(args: &BenchArgs) -> Result<ExitCode, CliError> {
         println!(
             "peak memory {:<14} {:>9} triangles {:>8.1} MB  (budget at 10^6 triangles: {MEMORY_BUDGET_MB} MB)",
             m.workload, m.triangles, m.peak_mb
+        );
+    }
+    println!();
+    println!(
+        "{:<52} {:>10} {:>8}  this run",
+        "target", "measured", "limit"
+    );
+    for t in &report.targets {
+        let verdict = if t.met {
+            "met".to_string()
+        } else if t.measured.is_nan() {
+            "missed (not reached)".to_string()
+        } else {
+            format!("missed ({:.1}× the limit)", t.measured / t.limit)
+        };
+        let measured = if t.measured.is_nan() {
+            "—".to_string()
+        } else {
+            format!("{:.2}", t.measured)
+        };
+        println!(
+            "{:<52} {measured:>10} {:>8.1}  {verdict}",
+            t.target, t.limit
         );
     }
     Ok(ExitCode::SUCCESS)
