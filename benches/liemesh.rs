@@ -1,9 +1,12 @@
 //! Criterion benchmarks of issue 6: (a) the six presets end to end, (b) sphere and
-//! ellipsoid at about 10^4 and 10^5 triangles split into sampling and triangulation,
+//! ellipsoid at about 10^4, 10^5 and 10^6 triangles: sampling, the chart triangulation with
+//! its closing and first flip pass, and the whole pipeline (the difference is the
+//! relaxation, its flip pass and the assembly of the working-precision vertices),
 //! (c) fig6 sampling per scalar type, (d) spade's bulk load of the same chart points.
-//! The 10^6-triangle workloads are only in `liemesh bench`.
 
-use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
+use criterion::{
+    criterion_group, criterion_main, BenchmarkId, Criterion, SamplingMode, Throughput,
+};
 use liemesh::model::{Invariant, LieField};
 use liemesh::preset::Preset;
 use liemesh::scalar::Dual;
@@ -62,7 +65,19 @@ fn presets(c: &mut Criterion) {
 fn sizes(c: &mut Criterion) {
     let mut g = configure(c, "surfaces");
     for (ellipsoid, label) in [(false, "sphere"), (true, "ellipsoid")] {
-        for (target, tag) in [(10_000, "1e4"), (100_000, "1e5")] {
+        for (target, tag, seconds) in [
+            (10_000, "1e4", 2),
+            (100_000, "1e5", 5),
+            (1_000_000, "1e6", 25),
+        ] {
+            // Ten samples of the slowest function (end to end) fit the measurement time;
+            // at a second per run, one run per sample.
+            g.measurement_time(Duration::from_secs(seconds))
+                .sampling_mode(if target > 10_000 {
+                    SamplingMode::Flat
+                } else {
+                    SamplingMode::Auto
+                });
             let (inv, params) = workload(ellipsoid, target);
             let field = LieField::<f64>::new(&inv);
             let samples = liemesh::sample::sample(&field, &params).unwrap();
@@ -76,6 +91,9 @@ fn sizes(c: &mut Criterion) {
                 b.iter(|| {
                     liemesh::triangulate::triangulate(black_box(&samples), true, true).unwrap()
                 })
+            });
+            g.bench_function(BenchmarkId::new("end_to_end", &id), |b| {
+                b.iter(|| liemesh::run(black_box(&field), &params).unwrap())
             });
             let chart: Vec<spade::Point2<f64>> = (0..samples.points.len())
                 .map(|i| {
