@@ -64,6 +64,27 @@ pub(super) fn agreement_at(corners: [[f64; 3]; 3], n: &[[f64; 3]], t: [u32; 3]) 
     }
 }
 
+/// `agreement(p, n, t) <= 0.0`, mostly from the sign of `f·g` alone: when it is finite and
+/// not positive the agreement is not either, and when it is well above underflow while
+/// `|f|²|g|²` is a normal number, the agreement is positive. Only the rest (vectors near
+/// underflow or overflow, NaN) go through the square root and division.
+fn against_field(p: &[[f64; 3]], n: &[[f64; 3]], t: [u32; 3]) -> bool {
+    let [a, b, c] = t.map(|i| p[i as usize]);
+    let f = cross(sub(b, a), sub(c, a));
+    let g = field_normal(n, t);
+    let fg = dot(f, g);
+    // (−∞ is left to the full test: there `|f||g|` overflows too and −∞/∞ is NaN.)
+    if fg <= 0.0 && fg.is_finite() {
+        return true;
+    }
+    // `d = √(|f|²|g|²)` lies in [1e-150, 1e150], so `fg / d ≥ 1e-320 > 0`.
+    let dd = dot(f, f) * dot(g, g);
+    if fg > 1e-170 && (1e-300..=1e300).contains(&dd) {
+        return false;
+    }
+    agreement(p, n, t) <= 0.0
+}
+
 /// No half-edge.
 const NONE: u32 = u32::MAX;
 
@@ -351,7 +372,7 @@ pub(crate) fn flip_to_surface_delaunay(
     let mut folded = FlagSet(par::map(tri.len().div_ceil(64), par::MIN_CHEAP / 64, |w| {
         let chunk = &tri[64 * w..(64 * w + 64).min(tri.len())];
         chunk.iter().enumerate().fold(0u64, |bits, (k, t)| {
-            bits | u64::from(agreement(points, normals, *t) <= 0.0) << k
+            bits | u64::from(against_field(points, normals, *t)) << k
         })
     }));
     let mut flips = 0;
@@ -417,8 +438,7 @@ pub(crate) fn flip_to_surface_delaunay(
         if c == d || he.adjacent(c, d) {
             continue;
         }
-        let new_ok =
-            agreement(points, normals, new1) > 0.0 && agreement(points, normals, new2) > 0.0;
+        let new_ok = !against_field(points, normals, new1) && !against_field(points, normals, new2);
         if !new_ok {
             continue;
         }
@@ -503,6 +523,33 @@ mod tests {
     fn half_edges_refuse_a_triangle_with_a_repeated_corner() {
         let mut t = vec![[0, 1, 1], [0, 1, 2]];
         assert!(HalfEdges::new(&mut t, 3).is_none());
+    }
+
+    #[test]
+    fn against_field_is_the_sign_of_the_agreement() {
+        let mut rng = crate::audit::XorShift64::new(17);
+        let mut against = 0;
+        for k in 0..30_000 {
+            // Ordinary scales for half the faces, from underflow to overflow for the rest, and
+            // some exactly degenerate faces.
+            let range = if k % 2 == 0 { 3.0 } else { 200.0 };
+            let scale = 10f64.powf(rng.uniform(-range, range));
+            let mut p: Vec<[f64; 3]> = (0..3).map(|_| rng.in_cube(scale)).collect();
+            if k % 10 == 0 {
+                p[2] = p[1];
+            }
+            let normal_scale = 10f64.powf(rng.uniform(-range, range));
+            let mut n: Vec<[f64; 3]> = (0..3).map(|_| rng.in_cube(normal_scale)).collect();
+            if k % 97 == 0 {
+                n[0][0] = f64::NAN;
+            }
+            let t = [0, 1, 2];
+            let want = agreement(&p, &n, t) <= 0.0;
+            against += usize::from(want);
+            assert_eq!(against_field(&p, &n, t), want, "{p:?} {n:?}");
+        }
+        // Both answers occur often (extreme scales make many faces degenerate).
+        assert!((5_000..25_000).contains(&against), "{against}");
     }
 
     #[test]
