@@ -58,8 +58,7 @@ impl Grid {
             return;
         };
         debug_assert_eq!(positions.len(), self.len + 1, "points are filed in order");
-        let key = self.key(p);
-        self.buckets.entry(key).or_default().push(self.len as u32);
+        self.file(p, self.len as u32);
         self.len += 1;
         if self.len >= self.next_review {
             self.next_review = 2 * self.len;
@@ -87,9 +86,13 @@ impl Grid {
         self.inv = inv;
         self.buckets.clear();
         for (i, &p) in positions.iter().enumerate() {
-            let key = self.key(p);
-            self.buckets.entry(key).or_default().push(i as u32);
+            self.file(p, i as u32);
         }
+    }
+
+    fn file(&mut self, p: [f64; 3], index: u32) {
+        let key = self.key(p);
+        self.buckets.entry(key).or_default().push(index);
     }
 
     /// Whether `f` holds for some stored index whose cell meets the ball of `radius` around

@@ -54,8 +54,11 @@ pub(super) fn agreement(p: &[[f64; 3]], n: &[[f64; 3]], t: [u32; 3]) -> f64 {
 /// [`agreement`] for a face whose corners `t` sit at `corners`.
 pub(super) fn agreement_at(corners: [[f64; 3]; 3], n: &[[f64; 3]], t: [u32; 3]) -> f64 {
     let [a, b, c] = corners;
-    let f = cross(sub(b, a), sub(c, a));
-    let g = field_normal(n, t);
+    cosine(cross(sub(b, a), sub(c, a)), field_normal(n, t))
+}
+
+/// Cosine of the angle between face normal `f` and field normal `g`; −1 when either vanishes.
+fn cosine(f: [f64; 3], g: [f64; 3]) -> f64 {
     let d = (dot(f, f) * dot(g, g)).sqrt();
     if d > 0.0 {
         dot(f, g) / d
@@ -69,9 +72,7 @@ pub(super) fn agreement_at(corners: [[f64; 3]; 3], n: &[[f64; 3]], t: [u32; 3]) 
 /// `|f|²|g|²` is a normal number, the agreement is positive. Only the rest (vectors near
 /// underflow or overflow, NaN) go through the square root and division.
 fn against_field(p: &[[f64; 3]], n: &[[f64; 3]], t: [u32; 3]) -> bool {
-    let [a, b, c] = t.map(|i| p[i as usize]);
-    let f = cross(sub(b, a), sub(c, a));
-    let g = field_normal(n, t);
+    let (f, g) = (face_normal(p, t), field_normal(n, t));
     let fg = dot(f, g);
     // (−∞ is left to the full test: there `|f||g|` overflows too and −∞/∞ is NaN.)
     if fg <= 0.0 && fg.is_finite() {
@@ -82,7 +83,7 @@ fn against_field(p: &[[f64; 3]], n: &[[f64; 3]], t: [u32; 3]) -> bool {
     if fg > 1e-170 && (1e-300..=1e300).contains(&dd) {
         return false;
     }
-    agreement(p, n, t) <= 0.0
+    cosine(f, g) <= 0.0
 }
 
 /// No half-edge.
@@ -552,15 +553,20 @@ mod tests {
         assert!((5_000..25_000).contains(&against), "{against}");
     }
 
-    #[test]
-    fn a_long_diagonal_is_flipped_and_a_short_one_kept() {
-        // A flat rhombus, normal +z: the long diagonal 0–2 faces two obtuse angles.
-        let p = vec![
+    /// A flat rhombus in the plane z = 0 whose diagonal 0–2 is the long one.
+    fn rhombus() -> Vec<[f64; 3]> {
+        vec![
             [-2.0, 0.0, 0.0],
             [0.0, -1.0, 0.0],
             [2.0, 0.0, 0.0],
             [0.0, 1.0, 0.0],
-        ];
+        ]
+    }
+
+    #[test]
+    fn a_long_diagonal_is_flipped_and_a_short_one_kept() {
+        // Normal +z: the long diagonal 0–2 faces two obtuse angles.
+        let p = rhombus();
         let n = vec![[0.0, 0.0, 1.0]; 4];
         let mut t = vec![[0, 1, 2], [0, 2, 3]];
         assert_eq!(flip_to_surface_delaunay(&p, &n, &mut t, 10), 1);
@@ -576,13 +582,8 @@ mod tests {
 
     #[test]
     fn flips_leave_a_non_manifold_mesh_alone() {
-        let p = vec![
-            [-2.0, 0.0, 0.0],
-            [0.0, -1.0, 0.0],
-            [2.0, 0.0, 0.0],
-            [0.0, 1.0, 0.0],
-            [0.0, 0.0, 1.0],
-        ];
+        let mut p = rhombus();
+        p.push([0.0, 0.0, 1.0]);
         let n = vec![[0.0, 0.0, 1.0]; 5];
         let mut t = vec![[0, 1, 2], [0, 2, 3], [0, 2, 4]];
         let before = t.clone();
