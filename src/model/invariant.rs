@@ -57,12 +57,28 @@ impl Lift {
     pub fn lower<T: Scalar>(self, p: &Vec3<T>) -> Vec3<T> {
         match self {
             Lift::Squares => {
-                let square = |x: &T| {
-                    let mut r = x.clone();
-                    r *= x;
+                let square = |x: &T| x.product(x);
+                Vec3::new(square(&p.x), square(&p.y), square(&p.z))
+            }
+        }
+    }
+
+    /// The derivative of [`Lift::lower`] at `p` along `w`, rounded as a dual-number pass
+    /// rounds it (`w p + p w` for a square).
+    #[inline(always)]
+    pub fn lower_derivative<T: Scalar>(self, p: &Vec3<T>, w: &Vec3<T>) -> Vec3<T> {
+        match self {
+            Lift::Squares => {
+                let derivative = |x: &T, dx: &T| {
+                    let mut r = dx.product(x);
+                    r.add_product(x, dx);
                     r
                 };
-                Vec3::new(square(&p.x), square(&p.y), square(&p.z))
+                Vec3::new(
+                    derivative(&p.x, &w.x),
+                    derivative(&p.y, &w.y),
+                    derivative(&p.z, &w.z),
+                )
             }
         }
     }

@@ -44,10 +44,8 @@ impl<T: Scalar> Dual<T> {
     }
     /// Multiplies both parts by a plain scalar (cheaper than a dual product).
     #[inline(always)]
-    pub fn scale(mut self, k: &T) -> Self {
-        self.re *= k;
-        self.eps *= k;
-        self
+    pub fn scale(&self, k: &T) -> Self {
+        Dual::new(self.re.product(k), self.eps.product(k))
     }
 }
 
@@ -80,9 +78,9 @@ impl<T: Scalar> Sub for Dual<T> {
 impl<T: Scalar> Mul for Dual<T> {
     type Output = Self;
     #[inline(always)]
-    fn mul(self, o: Self) -> Self {
-        let eps = self.eps * o.re.clone() + self.re.clone() * o.eps;
-        Dual::new(self.re * o.re, eps)
+    fn mul(mut self, o: Self) -> Self {
+        self *= &o;
+        self
     }
 }
 impl<T: Scalar> Div for Dual<T> {
@@ -140,13 +138,11 @@ impl<T: Scalar> SubAssign<&Dual<T>> for Dual<T> {
     }
 }
 impl<T: Scalar> MulAssign<&Dual<T>> for Dual<T> {
-    /// The same operations, in the same order, as `*self = self * o`.
+    /// `(a + a'ε)(b + b'ε) = ab + (a'b + ab')ε`.
     #[inline(always)]
     fn mul_assign(&mut self, o: &Self) {
-        let mut cross = self.re.clone();
-        cross *= &o.eps;
         self.eps *= &o.re;
-        self.eps += &cross;
+        self.eps.add_product(&self.re, &o.eps);
         self.re *= &o.re;
     }
 }
@@ -193,6 +189,13 @@ impl<T: Scalar> Scalar for Dual<T> {
     #[inline(always)]
     fn to_f64(&self) -> f64 {
         self.re.to_f64()
+    }
+    /// The same operations, in the same order, as `*self * o`.
+    #[inline(always)]
+    fn product(&self, o: &Self) -> Self {
+        let mut eps = self.eps.product(&o.re);
+        eps.add_product(&self.re, &o.eps);
+        Dual::new(self.re.product(&o.re), eps)
     }
     #[inline(always)]
     fn sqrt(&self) -> Self {

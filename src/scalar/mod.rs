@@ -63,6 +63,27 @@ pub trait Scalar:
     fn from_f64(x: f64) -> Self;
     /// The nearest `f64` (the real part for dual numbers).
     fn to_f64(&self) -> f64;
+    /// `self · o` as a new value. The default copies `self` and multiplies in place; MPFR
+    /// overrides it to write the product straight into a fresh number (the same rounding,
+    /// one copy fewer). Hot generic code multiplies through this.
+    #[inline(always)]
+    fn product(&self, o: &Self) -> Self {
+        let mut r = self.clone();
+        r *= o;
+        r
+    }
+    /// `self += a·b`, rounding the product and then the sum (not a fused multiply-add,
+    /// so it is exactly `*self += &a.product(b)`). MPFR overrides it to form the product
+    /// in a reused scratch number instead of a fresh one.
+    #[inline(always)]
+    fn add_product(&mut self, a: &Self, b: &Self) {
+        *self += &a.product(b);
+    }
+    /// `self -= a·b`, rounded like [`Scalar::add_product`].
+    #[inline(always)]
+    fn sub_product(&mut self, a: &Self, b: &Self) {
+        *self -= &a.product(b);
+    }
     /// Square root.
     fn sqrt(&self) -> Self;
     /// Sine (radians).

@@ -5,6 +5,7 @@ use num_traits::{Num, One, Zero};
 use rug::float::Constant;
 use rug::ops::Pow;
 use rug::Float;
+use std::cell::RefCell;
 use std::fmt;
 use std::ops::{Add, AddAssign, Div, DivAssign, Mul, MulAssign, Neg, Rem, Sub, SubAssign};
 
@@ -39,6 +40,29 @@ impl<const BITS: u32> Mpfr<BITS> {
     pub fn exp2i(k: i32) -> Self {
         Mpfr(Float::with_val(BITS, Float::with_val(BITS, 2).pow(k)))
     }
+}
+
+thread_local! {
+    /// The product in `add_product` / `sub_product`: one number per thread, reused, so an
+    /// accumulation allocates nothing (re-created only when the precision changes).
+    static SCRATCH: RefCell<Float> = RefCell::new(Float::new(64));
+}
+
+/// `acc ± a·b` with the product rounded to `BITS` in the thread's scratch number.
+#[inline]
+fn accumulate_product<const BITS: u32>(acc: &mut Float, a: &Float, b: &Float, subtract: bool) {
+    SCRATCH.with(|scratch| {
+        let mut t = scratch.borrow_mut();
+        if t.prec() != BITS {
+            *t = Float::new(BITS);
+        }
+        rug::Assign::assign(&mut *t, a * b);
+        if subtract {
+            *acc -= &*t;
+        } else {
+            *acc += &*t;
+        }
+    });
 }
 
 impl<const BITS: u32> fmt::Debug for Mpfr<BITS> {
@@ -134,6 +158,18 @@ impl<const BITS: u32> Scalar for Mpfr<BITS> {
     fn to_f64(&self) -> f64 {
         self.0.to_f64()
     }
+    #[inline]
+    fn product(&self, o: &Self) -> Self {
+        Mpfr(Float::with_val(BITS, &self.0 * &o.0))
+    }
+    #[inline]
+    fn add_product(&mut self, a: &Self, b: &Self) {
+        accumulate_product::<BITS>(&mut self.0, &a.0, &b.0, false);
+    }
+    #[inline]
+    fn sub_product(&mut self, a: &Self, b: &Self) {
+        accumulate_product::<BITS>(&mut self.0, &a.0, &b.0, true);
+    }
     fn sqrt(&self) -> Self {
         Mpfr(self.0.clone().sqrt())
     }
@@ -177,6 +213,32 @@ mod tests {
         assert_eq!(x.0.prec(), 256);
         let back = x.clone() * x - Mpfr::from_f64(2.0);
         assert!(back.abs().to_f64() < 1e-75);
+    }
+
+    #[test]
+    fn products_and_accumulations_round_like_the_operators() {
+        fn check<const BITS: u32>(a: f64, b: f64, c: f64) {
+            let third = Mpfr::<BITS>::from_f64(1.0) / Mpfr::from_f64(3.0);
+            let (a, b) = (
+                Mpfr::<BITS>::from_f64(a) * third.clone(),
+                Mpfr::from_f64(b).sqrt(),
+            );
+            let c = Mpfr::<BITS>::from_f64(c) / third;
+            assert_eq!(a.product(&b), a.clone() * b.clone());
+            let mut sum = c.clone();
+            sum.add_product(&a, &b);
+            assert_eq!(sum, c.clone() + a.clone() * b.clone());
+            let mut difference = c.clone();
+            difference.sub_product(&a, &b);
+            assert_eq!(difference, c - a * b);
+            assert_eq!(sum.0.prec(), BITS);
+        }
+        // Alternating precisions on one thread re-creates the shared scratch number.
+        for (a, b, c) in [(0.7, 2.0, -1.5), (-3e5, 7e-3, 0.25), (1e-30, 5.0, 1e-29)] {
+            check::<256>(a, b, c);
+            check::<64>(a, b, c);
+            check::<256>(c, b, a);
+        }
     }
 
     #[test]

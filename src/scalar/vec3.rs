@@ -41,17 +41,17 @@ impl<T: Scalar> Vec3<T> {
     /// Dot product.
     #[inline(always)]
     pub fn dot(&self, o: &Self) -> T {
-        let mut r = product(&self.x, &o.x);
-        r += &product(&self.y, &o.y);
-        r += &product(&self.z, &o.z);
+        let mut r = self.x.product(&o.x);
+        r.add_product(&self.y, &o.y);
+        r.add_product(&self.z, &o.z);
         r
     }
     /// Cross product.
     #[inline(always)]
     pub fn cross(&self, o: &Self) -> Self {
         let minor = |a: &T, b: &T, c: &T, d: &T| {
-            let mut r = product(a, b);
-            r -= &product(c, d);
+            let mut r = a.product(b);
+            r.sub_product(c, d);
             r
         };
         Vec3::new(
@@ -73,18 +73,14 @@ impl<T: Scalar> Vec3<T> {
     /// Multiplies every component by `k`.
     #[inline(always)]
     pub fn scale(&self, k: &T) -> Self {
-        Vec3::new(
-            product(&self.x, k),
-            product(&self.y, k),
-            product(&self.z, k),
-        )
+        Vec3::new(self.x.product(k), self.y.product(k), self.z.product(k))
     }
     /// `self + k·o`, the workhorse of the stepper.
     #[inline(always)]
     pub fn add_scaled(&self, k: &T, o: &Self) -> Self {
         // `k·o + self` is `self + k·o` exactly: IEEE addition and multiplication commute.
         let term = |a: &T, b: &T| {
-            let mut r = product(k, b);
+            let mut r = k.product(b);
             r += a;
             r
         };
@@ -93,6 +89,20 @@ impl<T: Scalar> Vec3<T> {
             term(&self.y, &o.y),
             term(&self.z, &o.z),
         )
+    }
+    /// `self += k·o` in place, rounded exactly like [`Vec3::add_scaled`].
+    #[inline(always)]
+    pub fn add_scaled_assign(&mut self, k: &T, o: &Self) {
+        self.x.add_product(k, &o.x);
+        self.y.add_product(k, &o.y);
+        self.z.add_product(k, &o.z);
+    }
+    /// `self -= k·o` in place, rounded exactly like `self.add_scaled(&-k, o)`.
+    #[inline(always)]
+    pub fn sub_scaled_assign(&mut self, k: &T, o: &Self) {
+        self.x.sub_product(k, &o.x);
+        self.y.sub_product(k, &o.y);
+        self.z.sub_product(k, &o.z);
     }
     /// The unit vector along `self` and the norm, or `None` when the norm is zero or not finite.
     #[inline(always)]
@@ -121,14 +131,6 @@ impl<T: Scalar> Vec3<T> {
     pub fn map<U: Scalar>(&self, mut f: impl FnMut(&T) -> U) -> Vec3<U> {
         Vec3::new(f(&self.x), f(&self.y), f(&self.z))
     }
-}
-
-/// `a·b` as a new value: one copy of `a`, multiplied in place (no copy of `b` for MPFR).
-#[inline(always)]
-fn product<T: Scalar>(a: &T, b: &T) -> T {
-    let mut r = a.clone();
-    r *= b;
-    r
 }
 
 impl<T: Scalar> AddAssign<&Vec3<T>> for Vec3<T> {

@@ -275,6 +275,10 @@ struct Chord<T> {
 /// a polynomial of degree ≤ 3 (every integrable field of this model), Simpson's rule is
 /// exact, so `F(p + L c) = F(p)`: the step stays on the level set. `G'(φ)` comes from two
 /// JVPs through dual numbers.
+///
+/// When `T` is more precise than `f64` and the field offers [`NormalField::in_f64`], `φ` is
+/// first solved in `f64` and then refined in `T`; otherwise Newton starts from the chord of
+/// the osculating circle.
 #[allow(clippy::too_many_arguments)]
 fn drift_free_chord<T: Scalar, F: NormalField<T>>(
     field: &F,
@@ -286,41 +290,36 @@ fn drift_free_chord<T: Scalar, F: NormalField<T>>(
     length: &T,
     kappa: &T,
 ) -> Result<Chord<T>, StepStop> {
-    let half = T::from_f64(0.5);
-    let four = T::from_f64(4.0);
-    let half_len = length.clone() * half.clone();
-    // Initial guess: the chord of the osculating circle, φ ≈ −κL/2.
-    let mut phi = -(kappa.clone() * half_len.clone());
-    let tol = T::from_f64(16.0 * T::unit_roundoff());
     let newton_budget = cfg.max_retries.clamp(4, 64);
-    let mut iterations = 0;
-    let mut converged = false;
-    for _ in 0..newton_budget {
-        iterations += 1;
-        let (s, c) = phi.sin_cos();
-        let dir = w.scale(&c).add_scaled(&s, n);
-        let perp = n.scale(&c).add_scaled(&-s, w);
-        let pm = p.add_scaled(&half_len, &dir);
-        let p1 = p.add_scaled(length, &dir);
-        let (vm, jm) = field.normal_and_jvp(&pm, &perp);
-        let (v1, j1) = field.normal_and_jvp(&p1, &perp);
-        let sum = &(v0 + &vm.scale(&four)) + &v1;
-        let g = sum.dot(&dir);
-        // d/dφ: the points move by (L/2) c⊥ and L c⊥.
-        let dsum = &jm.scale(&(four.clone() * half_len.clone())) + &j1.scale(length);
-        let dg = sum.dot(&perp) + dsum.dot(&dir);
-        if !(g.is_finite() && dg.is_finite()) || dg.is_zero() {
-            return Err(StepStop::NonFinite);
-        }
-        let delta = g / dg;
-        phi -= delta.clone();
-        if delta.abs() <= tol.clone() * scalar::max(T::one(), phi.abs()) {
-            converged = true;
-            break;
-        }
-    }
-    let (s, c) = phi.sin_cos();
-    let direction = w.scale(&c).add_scaled(&s, n);
+    let seed = if T::unit_roundoff() < f64::unit_roundoff() {
+        field.in_f64().and_then(|f64_field| {
+            let [p, v0, n, w] = [p, v0, n, w].map(|x| Vec3::from_f64(x.to_f64()));
+            let (length, kappa) = (length.to_f64(), kappa.to_f64());
+            let guess = -(kappa * (0.5 * length));
+            match chord_angle(
+                &f64_field,
+                &p,
+                &v0,
+                &n,
+                &w,
+                &length,
+                guess,
+                newton_budget,
+                false,
+            ) {
+                Ok(root) if root.converged => Some(T::from_f64(root.phi)),
+                _ => None,
+            }
+        })
+    } else {
+        None
+    };
+    let refining = seed.is_some();
+    // Initial guess without a seed: the chord of the osculating circle, φ ≈ −κL/2.
+    let guess = seed.unwrap_or_else(|| -(kappa.clone() * (length.clone() * T::from_f64(0.5))));
+    let root = chord_angle(field, p, v0, n, w, length, guess, newton_budget, refining)?;
+    let mut direction = w.scale(&root.cos);
+    direction.add_scaled_assign(&root.sin, n);
     let point = p.add_scaled(length, &direction);
     if !point.is_finite() {
         return Err(StepStop::NonFinite);
@@ -328,9 +327,129 @@ fn drift_free_chord<T: Scalar, F: NormalField<T>>(
     Ok(Chord {
         point,
         direction,
-        iterations,
-        limited: !converged,
+        iterations: root.iterations,
+        limited: !root.converged,
     })
+}
+
+/// The chord angle found by [`chord_angle`], with its sine and cosine.
+struct ChordAngle<T> {
+    phi: T,
+    sin: T,
+    cos: T,
+    iterations: u32,
+    converged: bool,
+}
+
+/// Newton's method for the chord angle from `phi`.
+///
+/// It stops when a correction falls below 16 units of roundoff of `φ`. When `refining` a
+/// guess that is already good to `f64`, Newton converges quadratically from the first
+/// iteration, so it also stops once the next correction, predicted from the last two
+/// (`δₖ³/δₖ₋₁²`), would fall below that: this saves the iteration that only confirms. It
+/// then also rotates the sine and cosine by each correction `δ` instead of evaluating them
+/// at the new `φ` (equal to rounding; the series for a tiny `δ` is short at 256 bits).
+#[allow(clippy::too_many_arguments)]
+fn chord_angle<T: Scalar, F: NormalField<T>>(
+    field: &F,
+    p: &Vec3<T>,
+    v0: &Vec3<T>,
+    n: &Vec3<T>,
+    w: &Vec3<T>,
+    length: &T,
+    mut phi: T,
+    budget: usize,
+    refining: bool,
+) -> Result<ChordAngle<T>, StepStop> {
+    let four = T::from_f64(4.0);
+    let half_len = length.clone() * T::from_f64(0.5);
+    let tol = T::from_f64(16.0 * T::unit_roundoff());
+    let mut previous = f64::INFINITY;
+    let (mut s, mut c) = phi.sin_cos();
+    // d/dφ: the points move by (L/2) c⊥ and L c⊥.
+    let middle_weight = four.clone() * half_len.clone();
+    let (mut iterations, mut converged) = (0, false);
+    while !converged && (iterations as usize) < budget {
+        iterations += 1;
+        // The vector updates below work in place (for MPFR: fewer fresh numbers); each
+        // rounds exactly as the expression in its comment.
+        let mut dir = w.scale(&c); // c w + s n
+        dir.add_scaled_assign(&s, n);
+        let mut perp = n.scale(&c); // c n − s w
+        perp.sub_scaled_assign(&s, w);
+        let pm = p.add_scaled(&half_len, &dir);
+        let p1 = p.add_scaled(length, &dir);
+        let (vm, jm) = field.normal_and_jvp(&pm, &perp);
+        let (v1, j1) = field.normal_and_jvp(&p1, &perp);
+        let mut sum = vm.scale(&four); // (v0 + 4 vm) + v1
+        sum += v0;
+        sum += &v1;
+        let g = sum.dot(&dir);
+        let mut dsum = jm.scale(&middle_weight); // 4 (L/2) jm + L j1
+        dsum.add_scaled_assign(length, &j1);
+        let dg = sum.dot(&perp) + dsum.dot(&dir);
+        if !(g.is_finite() && dg.is_finite()) || dg.is_zero() {
+            return Err(StepStop::NonFinite);
+        }
+        let delta = g / dg;
+        phi -= delta.clone();
+        if refining {
+            // sin(φ − δ) = s cos δ − c sin δ, cos(φ − δ) = c cos δ + s sin δ.
+            let (sd, cd) = small_angle_sin_cos(&delta);
+            let rotated_sin = s.product(&cd) - c.product(&sd);
+            c = c.product(&cd) + s.product(&sd);
+            s = rotated_sin;
+        } else {
+            (s, c) = phi.sin_cos();
+        }
+        let limit = tol.clone() * scalar::max(T::one(), phi.abs());
+        let d = delta.abs();
+        converged = d <= limit;
+        if refining && !converged {
+            let d = d.to_f64();
+            converged = previous.is_finite()
+                && d < 0.25 * previous
+                && d * d * d <= 0.25 * limit.to_f64() * previous * previous;
+            previous = d;
+        }
+    }
+    Ok(ChordAngle {
+        phi,
+        sin: s,
+        cos: c,
+        iterations,
+        converged,
+    })
+}
+
+/// `(sin δ, cos δ)` for a Newton correction `|δ| < 2⁻¹⁰` by their Taylor series, summed
+/// until a term falls below a quarter unit of roundoff of `δ`: a handful of products where
+/// MPFR's general sine would reduce and sum at full length (a few terms at `δ ≈ 10⁻¹⁶`
+/// and 256 bits; none beyond `δ` and `1` once `δ²` is below the roundoff).
+fn small_angle_sin_cos<T: Scalar>(delta: &T) -> (T, T) {
+    let magnitude = delta.to_f64().abs();
+    if magnitude.is_nan() || magnitude >= 1.0 / 1024.0 {
+        return delta.sin_cos();
+    }
+    let floor = 0.25 * T::unit_roundoff() * magnitude;
+    let (mut sin, mut cos) = (delta.clone(), T::one());
+    let (mut term, mut term_magnitude) = (delta.clone(), magnitude);
+    // `term` is δᵏ/k!; its sign in the series follows k mod 4: + (1), − (2, 3), + (0).
+    for k in 2..64_u32 {
+        term_magnitude *= magnitude / f64::from(k);
+        if term_magnitude < floor {
+            break;
+        }
+        term *= delta;
+        term /= T::from_f64(f64::from(k));
+        match k % 4 {
+            0 => cos += &term,
+            1 => sin += &term,
+            2 => cos -= &term,
+            _ => sin -= &term,
+        }
+    }
+    (sin, cos)
 }
 
 #[cfg(test)]
@@ -389,6 +508,75 @@ mod tests {
             w = s.carry;
         }
         assert!(((pot(p.to_f64()) - f0) / f0).abs() < 1e-13);
+    }
+
+    #[test]
+    fn small_angle_sine_and_cosine_match_the_library_functions() {
+        for d in [3e-4, -2e-5, 1e-9, 1e-16, 5e-20, 0.0] {
+            let (s, c) = small_angle_sin_cos(&d);
+            assert!((s - d.sin()).abs() <= f64::EPSILON * d.abs(), "{d}");
+            assert!((c - d.cos()).abs() <= f64::EPSILON, "{d}");
+        }
+    }
+
+    #[cfg(feature = "mpfr")]
+    #[test]
+    fn small_angle_sine_and_cosine_hold_at_256_bits() {
+        use crate::scalar::Mpfr;
+        let ulp = Mpfr::<256>::from_f64(2.0 * Mpfr::<256>::unit_roundoff());
+        for d in [3e-4, -2e-5, 1e-9, 1e-16, -1e-33, 1e-40, 1e-70] {
+            let d = Mpfr::<256>::from_f64(d) / Mpfr::from_f64(3.0);
+            let (s, c) = small_angle_sin_cos(&d);
+            let (ws, wc) = d.sin_cos();
+            assert!((s - ws).abs() <= ulp.clone() * d.abs(), "{d}");
+            assert!((c - wc).abs() <= ulp, "{d}");
+        }
+    }
+
+    /// A field that hides its `f64` copy, so the chord runs every iteration in `T`.
+    #[cfg(feature = "mpfr")]
+    struct Unseeded<F>(F);
+
+    #[cfg(feature = "mpfr")]
+    impl<T: Scalar, F: NormalField<T>> NormalField<T> for Unseeded<F> {
+        fn normal(&self, p: &Vec3<T>) -> Vec3<T> {
+            self.0.normal(p)
+        }
+        fn normal_and_jvp(&self, p: &Vec3<T>, w: &Vec3<T>) -> (Vec3<T>, Vec3<T>) {
+            self.0.normal_and_jvp(p, w)
+        }
+    }
+
+    #[cfg(feature = "mpfr")]
+    #[test]
+    fn a_chord_seeded_in_f64_lands_where_the_full_precision_solve_lands() {
+        use crate::scalar::Mpfr;
+        type M = Mpfr<256>;
+        for preset in [Preset::Fig3, Preset::Fig6] {
+            let seeded = LieField::<M>::new(&preset.invariant());
+            assert!(seeded.in_f64().is_some());
+            let unseeded = Unseeded(seeded.clone());
+            let params = preset.params();
+            let cfg = StepConfig::<M>::new(&params);
+            let mut p = Vec3::<M>::from_f64(params.p0);
+            let mut w = Vec3::<M>::from_f64([1.0, 0.0, 0.0]);
+            let dt = M::from_f64(params.dt);
+            let (mut fewer, mut steps) = (0, 0);
+            for _ in 0..12 {
+                let a = step(&seeded, &cfg, &p, &w, &dt).unwrap();
+                let b = step(&unseeded, &cfg, &p, &w, &dt).unwrap();
+                let gap = (&a.point - &b.point).norm();
+                assert!(gap.to_f64() < 1e-72, "{preset}: {gap}");
+                assert_eq!(a.limit, b.limit);
+                fewer += usize::from(a.iterations < b.iterations);
+                steps += 1;
+                (p, w) = (a.point, a.carry);
+            }
+            assert_eq!(
+                fewer, steps,
+                "{preset}: the seed saves iterations at every step"
+            );
+        }
     }
 
     #[test]
