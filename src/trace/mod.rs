@@ -343,12 +343,19 @@ struct ChordAngle<T> {
 
 /// Newton's method for the chord angle from `phi`.
 ///
-/// It stops when a correction falls below 16 units of roundoff of `φ`. When `refining` a
-/// guess that is already good to `f64`, Newton converges quadratically from the first
-/// iteration, so it also stops once the next correction, predicted from the last two
-/// (`δₖ³/δₖ₋₁²`), would fall below that: this saves the iteration that only confirms. It
-/// then also rotates the sine and cosine by each correction `δ` instead of evaluating them
-/// at the new `φ` (equal to rounding; the series for a tiny `δ` is short at 256 bits).
+/// It stops when a correction falls below 16 units of roundoff of `φ`.
+///
+/// When `refining` a guess already good to `f64`, Newton converges quadratically from the
+/// first iteration, `δₖ ≈ C δₖ₋₁²`, and three savings follow from estimating `C` on the
+/// last two corrections:
+/// - it stops once the next correction, `C δₖ²`, would fall below a quarter of the
+///   tolerance (this saves the iteration that only confirms);
+/// - when instead one more correction with the derivative kept from this iteration would
+///   end within a quarter of the tolerance (its error is about `2C δₖ` times that
+///   correction), it takes that last step with field values only, no Jacobian-vector
+///   products, and stops if the correction it measures bears that out;
+/// - it rotates the sine and cosine by each correction `δ` instead of evaluating them at
+///   the new `φ` (equal to rounding; the series for a tiny `δ` is short at 256 bits).
 #[allow(clippy::too_many_arguments)]
 fn chord_angle<T: Scalar, F: NormalField<T>>(
     field: &F,
@@ -364,10 +371,13 @@ fn chord_angle<T: Scalar, F: NormalField<T>>(
     let four = T::from_f64(4.0);
     let half_len = length.clone() * T::from_f64(0.5);
     let tol = T::from_f64(16.0 * T::unit_roundoff());
-    let mut previous = f64::INFINITY;
     let (mut s, mut c) = phi.sin_cos();
     // d/dφ: the points move by (L/2) c⊥ and L c⊥.
     let middle_weight = four.clone() * half_len.clone();
+    // Refining only: the last correction, and the derivative to keep with the error
+    // factor `2C δ` it carries when the next step is the last, value-only one.
+    let mut previous = f64::INFINITY;
+    let mut keep: Option<(T, f64)> = None;
     let (mut iterations, mut converged) = (0, false);
     while !converged && (iterations as usize) < budget {
         iterations += 1;
@@ -375,23 +385,35 @@ fn chord_angle<T: Scalar, F: NormalField<T>>(
         // rounds exactly as the expression in its comment.
         let mut dir = w.scale(&c); // c w + s n
         dir.add_scaled_assign(&s, n);
-        let mut perp = n.scale(&c); // c n − s w
-        perp.sub_scaled_assign(&s, w);
         let pm = p.add_scaled(&half_len, &dir);
         let p1 = p.add_scaled(length, &dir);
-        let (vm, jm) = field.normal_and_jvp(&pm, &perp);
-        let (v1, j1) = field.normal_and_jvp(&p1, &perp);
-        let mut sum = vm.scale(&four); // (v0 + 4 vm) + v1
-        sum += v0;
-        sum += &v1;
+        let kept = keep.take();
+        let (sum, dg) = match &kept {
+            Some((dg, _)) => {
+                let mut sum = field.normal(&pm).scale(&four); // (v0 + 4 vm) + v1
+                sum += v0;
+                sum += &field.normal(&p1);
+                (sum, dg.clone())
+            }
+            None => {
+                let mut perp = n.scale(&c); // c n − s w
+                perp.sub_scaled_assign(&s, w);
+                let (vm, jm) = field.normal_and_jvp(&pm, &perp);
+                let (v1, j1) = field.normal_and_jvp(&p1, &perp);
+                let mut sum = vm.scale(&four); // (v0 + 4 vm) + v1
+                sum += v0;
+                sum += &v1;
+                let mut dsum = jm.scale(&middle_weight); // 4 (L/2) jm + L j1
+                dsum.add_scaled_assign(length, &j1);
+                let dg = sum.dot(&perp) + dsum.dot(&dir);
+                (sum, dg)
+            }
+        };
         let g = sum.dot(&dir);
-        let mut dsum = jm.scale(&middle_weight); // 4 (L/2) jm + L j1
-        dsum.add_scaled_assign(length, &j1);
-        let dg = sum.dot(&perp) + dsum.dot(&dir);
         if !(g.is_finite() && dg.is_finite()) || dg.is_zero() {
             return Err(StepStop::NonFinite);
         }
-        let delta = g / dg;
+        let delta = g / dg.clone();
         phi -= delta.clone();
         if refining {
             // sin(φ − δ) = s cos δ − c sin δ, cos(φ − δ) = c cos δ + s sin δ.
@@ -406,10 +428,25 @@ fn chord_angle<T: Scalar, F: NormalField<T>>(
         let d = delta.abs();
         converged = d <= limit;
         if refining && !converged {
-            let d = d.to_f64();
-            converged = previous.is_finite()
-                && d < 0.25 * previous
-                && d * d * d <= 0.25 * limit.to_f64() * previous * previous;
+            let (d, quarter) = (d.to_f64(), 0.25 * limit.to_f64());
+            let shrinking = previous.is_finite() && d < 0.25 * previous;
+            converged = match kept {
+                Some((_, factor)) => shrinking && d * factor <= quarter,
+                None if shrinking => {
+                    let c_estimate = d / (previous * previous);
+                    let next = c_estimate * d * d;
+                    if next <= quarter {
+                        true
+                    } else {
+                        let factor = 2.0 * c_estimate * d;
+                        if next * factor <= quarter {
+                            keep = Some((dg, factor));
+                        }
+                        false
+                    }
+                }
+                None => false,
+            };
             previous = d;
         }
     }
@@ -566,7 +603,7 @@ mod tests {
                 let a = step(&seeded, &cfg, &p, &w, &dt).unwrap();
                 let b = step(&unseeded, &cfg, &p, &w, &dt).unwrap();
                 let gap = (&a.point - &b.point).norm();
-                assert!(gap.to_f64() < 1e-72, "{preset}: {gap}");
+                assert!(gap.to_f64() < 1e-74, "{preset}: {gap}");
                 assert_eq!(a.limit, b.limit);
                 fewer += usize::from(a.iterations < b.iterations);
                 steps += 1;
