@@ -261,3 +261,77 @@ fn the_presets_themselves_pass_the_checks() {
         assert!(result.is_ok(), "{preset}: {result:?}");
     }
 }
+
+/// A field that hides its `f64` copy, so every Newton iteration of a chord runs in MPFR.
+#[cfg(feature = "mpfr")]
+struct FullPrecisionOnly<F>(F);
+
+#[cfg(feature = "mpfr")]
+impl<T: liemesh::scalar::Scalar, F: liemesh::NormalField<T>> liemesh::NormalField<T>
+    for FullPrecisionOnly<F>
+{
+    fn normal(&self, p: &liemesh::scalar::Vec3<T>) -> liemesh::scalar::Vec3<T> {
+        self.0.normal(p)
+    }
+    fn normal_and_jvp(
+        &self,
+        p: &liemesh::scalar::Vec3<T>,
+        w: &liemesh::scalar::Vec3<T>,
+    ) -> (liemesh::scalar::Vec3<T>, liemesh::scalar::Vec3<T>) {
+        self.0.normal_and_jvp(p, w)
+    }
+}
+
+/// The `Mpfr<256>` chord solved in `f64` first and refined (with its predicted stops and its
+/// last value-only step) lands where the solve that runs every iteration at 256 bits lands,
+/// for random invariants, points, directions and step lengths.
+#[cfg(feature = "mpfr")]
+#[test]
+fn mpfr_chords_seeded_in_f64_agree_with_the_full_precision_solve() {
+    use liemesh::scalar::{Mpfr, Scalar, Vec3};
+    use liemesh::trace::{step, StepConfig, StepLimit};
+    type M = Mpfr<256>;
+    let strategy = (
+        prop_oneof![linear_invariant(), hamiltonian_invariant()],
+        prop::array::uniform3(-1.0..1.0f64),
+        prop::array::uniform3(-1.0..1.0f64),
+        0.01..0.3f64,
+    );
+    let config = Config {
+        cases: 96,
+        failure_persistence: None,
+        rng_seed: RngSeed::Fixed(SEED),
+        ..Config::default()
+    };
+    let compared = Cell::new(0);
+    TestRunner::new(config)
+        .run(&strategy, |(numbers, p, w, dt)| {
+            let invariant = Invariant::from_numbers(&numbers)
+                .map_err(|e| TestCaseError::fail(format!("bad strategy: {e}")))?;
+            let seeded = LieField::<M>::new(&invariant);
+            let full = FullPrecisionOnly(seeded.clone());
+            let cfg = StepConfig::<M>::new(&Preset::Fig6.params());
+            let (p, w, dt) = (Vec3::<M>::from_f64(p), Vec3::from_f64(w), M::from_f64(dt));
+            match (
+                step(&seeded, &cfg, &p, &w, &dt),
+                step(&full, &cfg, &p, &w, &dt),
+            ) {
+                (Ok(a), Ok(b)) if a.limit != StepLimit::Budget && b.limit != StepLimit::Budget => {
+                    let gap = (&a.point - &b.point).norm().to_f64();
+                    let scale = 1.0 + p.norm().to_f64() + a.dt.to_f64();
+                    prop_assert!(gap <= 1e-70 * scale, "points differ by {gap:e}");
+                    prop_assert!(a.iterations <= b.iterations);
+                    compared.set(compared.get() + 1);
+                }
+                (Err(a), Err(b)) => prop_assert_eq!(a, b),
+                _ => {}
+            }
+            Ok(())
+        })
+        .unwrap();
+    assert!(
+        compared.get() >= 48,
+        "only {} chords compared",
+        compared.get()
+    );
+}
