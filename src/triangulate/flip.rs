@@ -71,7 +71,7 @@ fn cosine(f: [f64; 3], g: [f64; 3]) -> f64 {
 /// not positive the agreement is not either, and when it is well above underflow while
 /// `|f|²|g|²` is a normal number, the agreement is positive. Only the rest (vectors near
 /// underflow or overflow, NaN) go through the square root and division.
-fn against_field(p: &[[f64; 3]], n: &[[f64; 3]], t: [u32; 3]) -> bool {
+pub(crate) fn against_field(p: &[[f64; 3]], n: &[[f64; 3]], t: [u32; 3]) -> bool {
     let (f, g) = (face_normal(p, t), field_normal(n, t));
     let fg = dot(f, g);
     // (−∞ is left to the full test: there `|f||g|` overflows too and −∞/∞ is NaN.)
@@ -346,18 +346,32 @@ impl FlagSet {
     }
 }
 
-/// Flips edges of `triangles` in place; returns the number of flips. At most
-/// `budget` flips are made. Triangles that do not form a consistently oriented 2-manifold
-/// are left as they are (a flip there could make an edge non-manifold).
+/// What a flip pass did.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) struct FlipPass {
+    /// How many edges were flipped.
+    pub flips: usize,
+    /// Whether some triangle still faces against the field ([`against_field`]) after the
+    /// pass; `None` when the triangles were not a consistently oriented manifold, so the
+    /// pass did not run and did not look.
+    pub folded: Option<bool>,
+}
+
+/// Flips edges of `triangles` in place. At most `budget` flips are made. Triangles that do
+/// not form a consistently oriented 2-manifold are left as they are (a flip there could make
+/// an edge non-manifold).
 pub(crate) fn flip_to_surface_delaunay(
     points: &[[f64; 3]],
     normals: &[[f64; 3]],
     triangles: &mut [[u32; 3]],
     budget: usize,
-) -> usize {
+) -> FlipPass {
     let max_visits = 20 * triangles.len() + 1000;
     let Some(mut he) = HalfEdges::new(triangles, points.len()) else {
-        return 0;
+        return FlipPass {
+            flips: 0,
+            folded: None,
+        };
     };
     // The queue: every edge once, in triangle order, then the edges around each flip in
     // the order of the flips. The first part is not stored but read from the triangles'
@@ -468,7 +482,12 @@ pub(crate) fn flip_to_surface_delaunay(
             queue.push_back((x.min(y), x.max(y)));
         }
     }
-    flips
+    // Flips only clear flags (both new triangles must agree with the field), so the flags
+    // left are exactly the triangles that still face against it.
+    FlipPass {
+        flips,
+        folded: Some(folded.0.iter().any(|&bits| bits != 0)),
+    }
 }
 
 #[cfg(test)]
@@ -569,7 +588,8 @@ mod tests {
         let p = rhombus();
         let n = vec![[0.0, 0.0, 1.0]; 4];
         let mut t = vec![[0, 1, 2], [0, 2, 3]];
-        assert_eq!(flip_to_surface_delaunay(&p, &n, &mut t, 10), 1);
+        let pass = flip_to_surface_delaunay(&p, &n, &mut t, 10);
+        assert_eq!((pass.flips, pass.folded), (1, Some(false)));
         let mut edges: Vec<_> = t
             .iter()
             .flat_map(|t| (0..3).map(move |k| (t[k], t[(k + 1) % 3])))
@@ -577,7 +597,19 @@ mod tests {
         edges.sort_unstable();
         assert!(edges.contains(&(1, 3)) || edges.contains(&(3, 1)));
         // Now Delaunay: a second pass changes nothing.
-        assert_eq!(flip_to_surface_delaunay(&p, &n, &mut t, 10), 0);
+        assert_eq!(flip_to_surface_delaunay(&p, &n, &mut t, 10).flips, 0);
+    }
+
+    #[test]
+    fn a_pass_reports_the_folds_it_leaves() {
+        // The field points down, so both triangles face against it, and so would the flipped
+        // pair: nothing is flipped, and the pass says the mesh still folds.
+        let p = rhombus();
+        let n = vec![[0.0, 0.0, -1.0]; 4];
+        let mut t = vec![[0, 1, 2], [0, 2, 3]];
+        let pass = flip_to_surface_delaunay(&p, &n, &mut t, 10);
+        assert_eq!((pass.flips, pass.folded), (0, Some(true)));
+        assert!(t.iter().all(|&t| against_field(&p, &n, t)));
     }
 
     #[test]
@@ -587,7 +619,8 @@ mod tests {
         let n = vec![[0.0, 0.0, 1.0]; 5];
         let mut t = vec![[0, 1, 2], [0, 2, 3], [0, 2, 4]];
         let before = t.clone();
-        assert_eq!(flip_to_surface_delaunay(&p, &n, &mut t, 10), 0);
+        let pass = flip_to_surface_delaunay(&p, &n, &mut t, 10);
+        assert_eq!((pass.flips, pass.folded), (0, None));
         assert_eq!(t, before);
     }
 }

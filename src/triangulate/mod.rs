@@ -94,22 +94,34 @@ pub fn triangulate<T: Scalar>(
     }
 
     let normals: Vec<[f64; 3]> = samples.normals.iter().map(|v| v.to_f64()).collect();
-    // Chart 1 (or what is kept of it) and a closing, flipped to surface Delaunay in place.
+    // Chart 1 (or what is kept of it) and a closing, flipped to surface Delaunay in place,
+    // with what the flip pass knows about folds.
     let finish = |mut all: Vec<[u32; 3]>, closing: &[[u32; 3]]| {
         all.extend_from_slice(closing);
+        let mut folded = None;
         if improve {
             let budget = 8 * all.len() + 64;
-            flip::flip_to_surface_delaunay(&pos, &normals, &mut all, budget);
+            folded = flip::flip_to_surface_delaunay(&pos, &normals, &mut all, budget).folded;
         }
-        all
+        // Every mesh the test suite makes checks the flags against a rescan.
+        debug_assert!(
+            folded.is_none_or(|f| f == folds(&all, &pos, &normals)),
+            "the flip pass's fold flags disagree with a rescan"
+        );
+        (all, folded)
+    };
+    // Whether finished triangles face against the field somewhere: the flip pass knows when
+    // it ran; otherwise look.
+    let still_folds = |all: &[[u32; 3]], folded: Option<bool>| {
+        folded.unwrap_or_else(|| folds(all, &pos, &normals))
     };
     // The finished triangles, once some closing (or none) is settled on.
     let mut finished = None;
     if !closing.is_empty() {
-        let all = finish(triangles.clone(), &closing);
+        let (all, folded) = finish(triangles.clone(), &closing);
         // Closing triangles across a thin, twisted hole can face against the field, and flips
         // cannot always turn them round: then the hole stays open rather than folded.
-        if folds(&all, &pos, &normals) {
+        if still_folds(&all, folded) {
             closing.clear();
         } else {
             finished = Some(all);
@@ -123,8 +135,8 @@ pub fn triangulate<T: Scalar>(
             if !stitches_cleanly(&kept, fill, n) {
                 return None;
             }
-            let all = finish(kept, fill);
-            (!folds(&all, &pos, &normals)).then_some(all)
+            let (all, folded) = finish(kept, fill);
+            (!still_folds(&all, folded)).then_some(all)
         };
         if let Some(r) = reopen::reclose(&front, &triangles, &pos, &normals, accept) {
             triangles = r.kept;
@@ -132,7 +144,7 @@ pub fn triangulate<T: Scalar>(
             finished = Some(r.finished);
         }
     }
-    let mut all = finished.unwrap_or_else(|| finish(triangles.clone(), &closing));
+    let mut all = finished.unwrap_or_else(|| finish(triangles.clone(), &closing).0);
     // Three points on a line in space (curves that ran straight along a degenerate field)
     // make a triangle of no area and no normal, however good it looks in the chart.
     all.retain(|t| {
@@ -550,11 +562,11 @@ fn frame_around(normals: impl Iterator<Item = [f64; 3]>) -> Option<[[f64; 3]; 3]
 }
 
 /// Whether any of `triangles` faces against the field normal at its corners (a closing
-/// triangle across a thin, twisted hole can).
+/// triangle across a thin, twisted hole can): the flip pass's own test.
 fn folds(triangles: &[[u32; 3]], pos: &[[f64; 3]], normals: &[[f64; 3]]) -> bool {
     triangles
         .iter()
-        .any(|&t| dot3(flip::face_normal(pos, t), flip::field_normal(normals, t)) <= 0.0)
+        .any(|&t| flip::against_field(pos, normals, t))
 }
 
 /// Whether `closing` meets `chart` edge to edge: every directed edge is used once, and every
