@@ -295,7 +295,8 @@ fn mpfr_chords_seeded_in_f64_agree_with_the_full_precision_solve() {
         prop_oneof![linear_invariant(), hamiltonian_invariant()],
         prop::array::uniform3(-1.0..1.0f64),
         prop::array::uniform3(-1.0..1.0f64),
-        0.01..0.3f64,
+        // Up to long chords, where Newton in f64 can wander to another root of G first.
+        prop_oneof![0.01..0.3f64, 0.3..3.0f64],
     );
     let config = Config {
         cases: 96,

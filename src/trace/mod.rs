@@ -296,6 +296,11 @@ fn drift_free_chord<T: Scalar, F: NormalField<T>>(
             let [p, v0, n, w] = [p, v0, n, w].map(|x| Vec3::from_f64(x.to_f64()));
             let (length, kappa) = (length.to_f64(), kappa.to_f64());
             let guess = -(kappa * (0.5 * length));
+            // Only a solve that converged the way Newton does near its root (every correction
+            // smaller than the one before, in a few iterations) seeds `T`: started from the
+            // same guess, the solve in `T` would then follow it to the same root. A solve
+            // that wanders first may end at another root of G than the full-precision one
+            // would, so `T` then starts from the guess itself, as without a seed.
             match chord_angle(
                 &f64_field,
                 &p,
@@ -305,19 +310,25 @@ fn drift_free_chord<T: Scalar, F: NormalField<T>>(
                 &length,
                 guess,
                 newton_budget,
-                false,
+                Solve::Seed,
             ) {
-                Ok(root) if root.converged => Some(T::from_f64(root.phi)),
+                Ok(root) if root.converged && root.settled && root.iterations <= 8 => {
+                    Some(T::from_f64(root.phi))
+                }
                 _ => None,
             }
         })
     } else {
         None
     };
-    let refining = seed.is_some();
+    let solve = if seed.is_some() {
+        Solve::Refine
+    } else {
+        Solve::Full
+    };
     // Initial guess without a seed: the chord of the osculating circle, φ ≈ −κL/2.
     let guess = seed.unwrap_or_else(|| -(kappa.clone() * (length.clone() * T::from_f64(0.5))));
-    let root = chord_angle(field, p, v0, n, w, length, guess, newton_budget, refining)?;
+    let root = chord_angle(field, p, v0, n, w, length, guess, newton_budget, solve)?;
     let mut direction = w.scale(&root.cos);
     direction.add_scaled_assign(&root.sin, n);
     let point = p.add_scaled(length, &direction);
@@ -332,6 +343,18 @@ fn drift_free_chord<T: Scalar, F: NormalField<T>>(
     })
 }
 
+/// How [`chord_angle`] runs.
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum Solve {
+    /// From the osculating circle's guess to the tolerance, every iteration in `T`.
+    Full,
+    /// As `Full`, in `f64`, for a seed: also watches whether the corrections settle.
+    Seed,
+    /// Refining a seed good to `f64` (predicted stops, a value-only last step, rotated
+    /// sine and cosine).
+    Refine,
+}
+
 /// The chord angle found by [`chord_angle`], with its sine and cosine.
 struct ChordAngle<T> {
     phi: T,
@@ -339,13 +362,16 @@ struct ChordAngle<T> {
     cos: T,
     iterations: u32,
     converged: bool,
+    /// Every correction after the first was smaller than the one before it (watched for
+    /// [`Solve::Seed`] only; `true` otherwise).
+    settled: bool,
 }
 
 /// Newton's method for the chord angle from `phi`.
 ///
 /// It stops when a correction falls below 16 units of roundoff of `φ`.
 ///
-/// When `refining` a guess already good to `f64`, Newton converges quadratically from the
+/// When refining ([`Solve::Refine`]) a guess already good to `f64`, Newton converges quadratically from the
 /// first iteration, `δₖ ≈ C δₖ₋₁²`, and three savings follow from estimating `C` on the
 /// last two corrections:
 /// - it stops once the next correction, `C δₖ²`, would fall below a quarter of the
@@ -366,8 +392,9 @@ fn chord_angle<T: Scalar, F: NormalField<T>>(
     length: &T,
     mut phi: T,
     budget: usize,
-    refining: bool,
+    solve: Solve,
 ) -> Result<ChordAngle<T>, StepStop> {
+    let refining = solve == Solve::Refine;
     let four = T::from_f64(4.0);
     let half_len = length.clone() * T::from_f64(0.5);
     let tol = T::from_f64(16.0 * T::unit_roundoff());
@@ -379,6 +406,7 @@ fn chord_angle<T: Scalar, F: NormalField<T>>(
     let mut previous = f64::INFINITY;
     let mut keep: Option<(T, f64)> = None;
     let (mut iterations, mut converged) = (0, false);
+    let (mut settled, mut last_correction) = (true, f64::INFINITY);
     while !converged && (iterations as usize) < budget {
         iterations += 1;
         // The vector updates below work in place (for MPFR: fewer fresh numbers); each
@@ -426,6 +454,11 @@ fn chord_angle<T: Scalar, F: NormalField<T>>(
         }
         let limit = tol.clone() * scalar::max(T::one(), phi.abs());
         let d = delta.abs();
+        if solve == Solve::Seed {
+            let correction = d.to_f64();
+            settled &= correction < last_correction;
+            last_correction = correction;
+        }
         converged = d <= limit;
         if refining && !converged {
             let (d, quarter) = (d.to_f64(), 0.25 * limit.to_f64());
@@ -456,6 +489,7 @@ fn chord_angle<T: Scalar, F: NormalField<T>>(
         cos: c,
         iterations,
         converged,
+        settled,
     })
 }
 
