@@ -362,8 +362,8 @@ struct ChordAngle<T> {
     cos: T,
     iterations: u32,
     converged: bool,
-    /// Every correction after the first was smaller than the one before it (watched for
-    /// [`Solve::Seed`] only; `true` otherwise).
+    /// Every correction after the first was smaller than the one before it (not watched,
+    /// so `true`, for [`Solve::Full`]).
     settled: bool,
 }
 
@@ -371,9 +371,9 @@ struct ChordAngle<T> {
 ///
 /// It stops when a correction falls below 16 units of roundoff of `φ`.
 ///
-/// When refining ([`Solve::Refine`]) a guess already good to `f64`, Newton converges quadratically from the
-/// first iteration, `δₖ ≈ C δₖ₋₁²`, and three savings follow from estimating `C` on the
-/// last two corrections:
+/// When refining ([`Solve::Refine`]) a guess already good to `f64`, Newton converges
+/// quadratically from the first iteration, `δₖ ≈ C δₖ₋₁²`, and three savings follow from
+/// estimating `C` on the last two corrections:
 /// - it stops once the next correction, `C δₖ²`, would fall below a quarter of the
 ///   tolerance (this saves the iteration that only confirms);
 /// - when instead one more correction with the derivative kept from this iteration would
@@ -401,12 +401,12 @@ fn chord_angle<T: Scalar, F: NormalField<T>>(
     let (mut s, mut c) = phi.sin_cos();
     // d/dφ: the points move by (L/2) c⊥ and L c⊥.
     let middle_weight = four.clone() * half_len.clone();
-    // Refining only: the last correction, and the derivative to keep with the error
-    // factor `2C δ` it carries when the next step is the last, value-only one.
+    // Seed and refine only: the last correction's size. Refine only: the derivative to
+    // keep, with the error factor `2C δ` it carries, when the next step is the last,
+    // value-only one.
     let mut previous = f64::INFINITY;
     let mut keep: Option<(T, f64)> = None;
-    let (mut iterations, mut converged) = (0, false);
-    let (mut settled, mut last_correction) = (true, f64::INFINITY);
+    let (mut iterations, mut converged, mut settled) = (0, false, true);
     while !converged && (iterations as usize) < budget {
         iterations += 1;
         // The vector updates below work in place (for MPFR: fewer fresh numbers); each
@@ -454,14 +454,14 @@ fn chord_angle<T: Scalar, F: NormalField<T>>(
         }
         let limit = tol.clone() * scalar::max(T::one(), phi.abs());
         let d = delta.abs();
-        if solve == Solve::Seed {
-            let correction = d.to_f64();
-            settled &= correction < last_correction;
-            last_correction = correction;
-        }
         converged = d <= limit;
+        if solve == Solve::Full {
+            continue;
+        }
+        let d = d.to_f64();
+        settled &= d < previous;
         if refining && !converged {
-            let (d, quarter) = (d.to_f64(), 0.25 * limit.to_f64());
+            let quarter = 0.25 * limit.to_f64();
             let shrinking = previous.is_finite() && d < 0.25 * previous;
             converged = match kept {
                 Some((_, factor)) => shrinking && d * factor <= quarter,
@@ -480,8 +480,8 @@ fn chord_angle<T: Scalar, F: NormalField<T>>(
                 }
                 None => false,
             };
-            previous = d;
         }
+        previous = d;
     }
     Ok(ChordAngle {
         phi,
