@@ -95,11 +95,9 @@ fn sizes(c: &mut Criterion) {
             g.bench_function(BenchmarkId::new("end_to_end", &id), |b| {
                 b.iter(|| liemesh::run(black_box(&field), &params).unwrap())
             });
-            let chart: Vec<spade::Point2<f64>> = (0..samples.points.len())
-                .map(|i| {
-                    let p = samples.chart(i);
-                    spade::Point2::new(p[0], p[1])
-                })
+            let chart: Vec<spade::Point2<f64>> = liemesh::triangulate::chart_points(&samples)
+                .into_iter()
+                .map(|[x, y]| spade::Point2::new(x, y))
                 .collect();
             g.bench_function(BenchmarkId::new("spade_bulk_load", &id), |b| {
                 b.iter(|| {

@@ -311,11 +311,9 @@ fn time_workload(
             ));
         }
         let t2 = Instant::now();
-        let chart: Vec<spade::Point2<f64>> = (0..samples.points.len())
-            .map(|i| {
-                let c = samples.chart(i);
-                spade::Point2::new(c[0], c[1])
-            })
+        let chart: Vec<spade::Point2<f64>> = crate::triangulate::chart_points(&samples)
+            .into_iter()
+            .map(|[x, y]| spade::Point2::new(x, y))
             .collect();
         let t3 = Instant::now();
         let dt = spade::DelaunayTriangulation::<spade::Point2<f64>>::bulk_load(chart)
