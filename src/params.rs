@@ -63,7 +63,9 @@ pub struct Budget {
     pub max_curves: usize,
     /// Most accepted steps on one curve.
     pub max_steps_per_curve: usize,
-    /// Most Δt retries within one step (paper mode), or Newton iterations (default mode).
+    /// Most Δt retries within one step (paper mode), or Newton iterations for one chord
+    /// (default mode, clamped to 4..=64; a chord that finds no root is retried at half the
+    /// length, up to [`CHORD_HALVINGS`](crate::trace::CHORD_HALVINGS) times).
     pub max_retries: usize,
 }
 

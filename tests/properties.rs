@@ -336,3 +336,69 @@ fn mpfr_chords_seeded_in_f64_agree_with_the_full_precision_solve() {
         compared.get()
     );
 }
+
+/// In the default mode every step is a chord that balances Simpson's rule,
+/// `(v(p) + 4 v(m) + v(q))·(q − p) = 0`, to rounding: on random fields far from integrable,
+/// with β bands up to 30°–60°, where the chord at the band's Δt can have no root and the step
+/// is halved instead (`StepLimit::Budget`) — never a point wherever Newton's method stopped.
+#[test]
+fn default_mode_steps_balance_simpsons_rule_even_where_the_chord_is_halved() {
+    use liemesh::scalar::Vec3;
+    use liemesh::trace::StepLimit;
+    use liemesh::NormalField;
+    let strategy = (
+        prop::collection::vec(-1.0..1.0f64, 12),
+        prop::array::uniform3(-1.0..1.0f64),
+        4.0..30.0f64,
+    );
+    let config = Config {
+        cases: 512,
+        failure_persistence: None,
+        rng_seed: RngSeed::Fixed(SEED),
+        ..Config::default()
+    };
+    let (checked, halved) = (Cell::new(0), Cell::new(0));
+    TestRunner::new(config)
+        .run(&strategy, |(numbers, p0, beta_min)| {
+            let invariant = Invariant::from_numbers(&numbers)
+                .map_err(|e| TestCaseError::fail(format!("bad strategy: {e}")))?;
+            let field = LieField::<f64>::new(&invariant);
+            let mut params = Preset::Fig6.params();
+            params.p0 = p0;
+            params.beta_min = beta_min.to_radians();
+            params.beta_max = (2.0 * beta_min).to_radians();
+            params.budget.max_points = 3_000;
+            let Ok(samples) = liemesh::sample::sample(&field, &params) else {
+                return Ok(());
+            };
+            for curve in &samples.curves {
+                for pair in curve.points.windows(2) {
+                    let [p, q] = [pair[0], pair[1]].map(|i| &samples.points[i as usize]);
+                    let m = p.add_scaled(&0.5, &(q - p));
+                    let [a, b, c] = [p, &m, q].map(|x: &Vec3<f64>| field.normal(x));
+                    let chord = (q - p).normalize().unwrap().0;
+                    let g = (&(&a + &b.scale(&4.0)) + &c).dot(&chord);
+                    let size = a.norm() + 4.0 * b.norm() + c.norm();
+                    prop_assert!(
+                        g.abs() <= 1e-10 * size,
+                        "step to point {} leaves Simpson's rule unbalanced by {:e}",
+                        pair[1],
+                        g.abs() / size
+                    );
+                    checked.set(checked.get() + 1);
+                }
+            }
+            let budget = samples
+                .steps
+                .iter()
+                .filter(|s| s.limit == StepLimit::Budget);
+            halved.set(halved.get() + budget.count());
+            Ok(())
+        })
+        .unwrap();
+    assert!(checked.get() >= 10_000, "only {} steps", checked.get());
+    assert!(
+        halved.get() > 0,
+        "no step was halved: the property is not exercised"
+    );
+}

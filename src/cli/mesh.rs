@@ -138,7 +138,8 @@ pub struct Overrides {
     /// Steps-per-curve budget.
     #[arg(long)]
     pub max_steps: Option<usize>,
-    /// Retries-per-step budget.
+    /// Retries-per-step budget (paper mode), or Newton iterations per chord (default mode,
+    /// 4 to 64).
     #[arg(long)]
     pub max_retries: Option<usize>,
 }

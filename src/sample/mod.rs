@@ -35,7 +35,8 @@ pub enum CurveEnd {
     Merge,
     /// Met a singular point (vanishing normal, no tangent direction, non-finite value).
     Singular,
-    /// A budget ran out.
+    /// A budget ran out: points, steps per curve, or Newton's iterations for a chord at
+    /// every length tried ([`StepStop::NoChord`](crate::trace::StepStop::NoChord)).
     Budget,
 }
 
@@ -304,6 +305,7 @@ impl<T: Scalar, F: NormalField<T>> Sampler<'_, T, F> {
         let live = &self.live[ci];
         let step = match trace::step(self.field, &self.cfg, &live.p, &live.carry, &live.dt) {
             Ok(s) => s,
+            Err(trace::StepStop::NoChord) => return Some(CurveEnd::Budget),
             Err(_) => return Some(CurveEnd::Singular),
         };
         let len = step.dt.to_f64();

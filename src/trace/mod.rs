@@ -57,7 +57,20 @@ pub enum StepStop {
     NoTangent,
     /// The new point is not finite.
     NonFinite,
+    /// Default mode: the drift-free chord's Newton solve found no root within its budget,
+    /// at the step's length nor at any of its [`CHORD_HALVINGS`] halvings (the field turns
+    /// too fast there for a chord to balance it, as on fields far from integrable).
+    NoChord,
 }
+
+/// How many times a default-mode step halves its length when the chord's Newton solve finds
+/// no root, before the curve ends with [`StepStop::NoChord`].
+pub const CHORD_HALVINGS: u32 = 3;
+
+/// A Newton correction that stops shrinking (by half or more) within this many tolerances is
+/// the rounding floor of the chord equation: `G` is evaluated with rounding noise, and the
+/// corrections then jump between a few values just above the tolerance.
+const STALL_TOLERANCES: f64 = 64.0;
 
 /// Which limit, if any, an accepted step ran into.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
@@ -67,7 +80,8 @@ pub enum StepLimit {
     None,
     /// Δt hit `dt_min` or `dt_max`, so α may lie outside the band.
     Clamped,
-    /// The retry (paper) or Newton (default) budget ran out.
+    /// Paper mode: the retry budget ran out. Default mode: the chord's Newton solve found
+    /// no root at the Δt chosen, and the step was halved until it did.
     Budget,
 }
 
@@ -86,7 +100,8 @@ pub struct Step<T> {
     pub dt: T,
     /// The predicted normal-turn angle α of the accepted Δt, radians.
     pub alpha_predicted: f64,
-    /// How many Δt retries (paper) or Newton iterations (default) the step took.
+    /// How many Δt retries (paper) or Newton iterations (default, over every length tried)
+    /// the step took.
     pub iterations: u32,
     /// A limit the step ran into.
     pub limit: StepLimit,
@@ -197,6 +212,24 @@ pub fn step<T: Scalar, F: NormalField<T>>(
                 dt = cfg.dt_min.clone();
                 limit = StepLimit::Clamped;
             }
+            let kappa = w.dot(&jw) / vlen.clone();
+            let mut chord = drift_free_chord(field, cfg, p, &v, &n, &w, &dt, &kappa)?;
+            let mut iterations = chord.iterations;
+            // No root near the osculating circle's chord: the field turns too fast over Δt.
+            // A shorter chord turns less; the step is marked as limited by the budget.
+            for halving in 1..=CHORD_HALVINGS + 1 {
+                if chord.converged {
+                    break;
+                }
+                let half = dt.clone() * T::from_f64(0.5);
+                if halving > CHORD_HALVINGS || half < cfg.dt_min {
+                    return Err(StepStop::NoChord);
+                }
+                dt = half;
+                limit = StepLimit::Budget;
+                chord = drift_free_chord(field, cfg, p, &v, &n, &w, &dt, &kappa)?;
+                iterations += chord.iterations;
+            }
             // α only reports on the closed-form Δt here, so `f64` is enough (and it is the
             // same number for `f64` and `Dual<f64>`); MPFR is spared an arc tangent.
             let alpha = {
@@ -207,11 +240,6 @@ pub fn step<T: Scalar, F: NormalField<T>>(
                 && (alpha < cfg.beta_min.to_f64() || alpha > cfg.beta_max.to_f64())
             {
                 limit = StepLimit::Clamped;
-            }
-            let kappa = w.dot(&jw) / vlen.clone();
-            let chord = drift_free_chord(field, cfg, p, &v, &n, &w, &dt, &kappa)?;
-            if chord.limited && limit == StepLimit::None {
-                limit = StepLimit::Budget;
             }
             // The end tangent of a circular arc is the start tangent reflected in the chord.
             let cw = chord.direction.dot(&w);
@@ -226,7 +254,7 @@ pub fn step<T: Scalar, F: NormalField<T>>(
                 normal: n,
                 alpha_predicted: alpha,
                 dt,
-                iterations: chord.iterations,
+                iterations,
                 limit,
             })
         }
@@ -235,6 +263,9 @@ pub fn step<T: Scalar, F: NormalField<T>>(
 
 /// A step of fixed length from `p` along the tangent part of `dir`, with the same rule as
 /// the mode's steps (used to place the first point of an inserted curve on the surface).
+///
+/// In the default mode, a chord whose Newton solve finds no root is
+/// [`StepStop::NoChord`]: the length is not the caller's to change.
 pub fn step_fixed<T: Scalar, F: NormalField<T>>(
     field: &F,
     cfg: &StepConfig<T>,
@@ -256,7 +287,12 @@ pub fn step_fixed<T: Scalar, F: NormalField<T>>(
         Mode::Default => {
             let (_, jw) = field.normal_and_jvp(p, &w);
             let kappa = w.dot(&jw) / vlen;
-            Ok(drift_free_chord(field, cfg, p, &v, &n, &w, length, &kappa)?.point)
+            let chord = drift_free_chord(field, cfg, p, &v, &n, &w, length, &kappa)?;
+            if chord.converged {
+                Ok(chord.point)
+            } else {
+                Err(StepStop::NoChord)
+            }
         }
     }
 }
@@ -265,7 +301,8 @@ struct Chord<T> {
     point: Vec3<T>,
     direction: Vec3<T>,
     iterations: u32,
-    limited: bool,
+    /// Whether Newton's method found the root (else the point is wherever it stopped).
+    converged: bool,
 }
 
 /// The chord `p + L c`, `c = cos φ w + sin φ n`, with `φ` solving
@@ -339,7 +376,7 @@ fn drift_free_chord<T: Scalar, F: NormalField<T>>(
         point,
         direction,
         iterations: root.iterations,
-        limited: !root.converged,
+        converged: root.converged,
     })
 }
 
@@ -369,7 +406,8 @@ struct ChordAngle<T> {
 
 /// Newton's method for the chord angle from `phi`.
 ///
-/// It stops when a correction falls below 16 units of roundoff of `φ`.
+/// It stops when a correction falls below 16 units of roundoff of `φ`, or below
+/// [`STALL_TOLERANCES`] times that without having halved the one before (the rounding floor).
 ///
 /// When refining ([`Solve::Refine`]) a guess already good to `f64`, Newton converges
 /// quadratically from the first iteration, `δₖ ≈ C δₖ₋₁²`, and three savings follow from
@@ -401,9 +439,8 @@ fn chord_angle<T: Scalar, F: NormalField<T>>(
     let (mut s, mut c) = phi.sin_cos();
     // d/dφ: the points move by (L/2) c⊥ and L c⊥.
     let middle_weight = four.clone() * half_len.clone();
-    // Seed and refine only: the last correction's size. Refine only: the derivative to
-    // keep, with the error factor `2C δ` it carries, when the next step is the last,
-    // value-only one.
+    // The last correction's size. Refine only: the derivative to keep, with the error factor
+    // `2C δ` it carries, when the next step is the last, value-only one.
     let mut previous = f64::INFINITY;
     let mut keep: Option<(T, f64)> = None;
     let (mut iterations, mut converged, mut settled) = (0, false, true);
@@ -455,10 +492,17 @@ fn chord_angle<T: Scalar, F: NormalField<T>>(
         let limit = tol.clone() * scalar::max(T::one(), phi.abs());
         let d = delta.abs();
         converged = d <= limit;
+        let d = d.to_f64();
+        // At the rounding floor (see `STALL_TOLERANCES`) the solve is as good as it gets.
+        // Newton from the osculating guess converges in two or three iterations where it
+        // converges at all, so the check waits for the fourth.
+        if !converged && iterations >= 4 {
+            converged = d <= STALL_TOLERANCES * limit.to_f64() && d > 0.5 * previous;
+        }
         if solve == Solve::Full {
+            previous = d;
             continue;
         }
-        let d = d.to_f64();
         settled &= d < previous;
         if refining && !converged {
             let quarter = 0.25 * limit.to_f64();
@@ -579,6 +623,149 @@ mod tests {
             w = s.carry;
         }
         assert!(((pot(p.to_f64()) - f0) / f0).abs() < 1e-13);
+    }
+
+    /// Two random 12-number invariants (uniform in [−1, 1]), far from integrable, whose meshes
+    /// ran into the chord equation's failures below.
+    const RANDOM_A: [f64; 12] = [
+        -0.37170565924641696,
+        0.17112372701527745,
+        -0.09363124725844929,
+        -0.4004660062726353,
+        0.5887589630449823,
+        0.3979888674591425,
+        -0.5118069785556942,
+        0.148847420517342,
+        0.050393007622902886,
+        0.7502749911468578,
+        0.4588905788784352,
+        -0.42412447021962696,
+    ];
+    const RANDOM_B: [f64; 12] = [
+        0.766767652883025,
+        0.6385596756714826,
+        0.7279689393970303,
+        -0.4431578709722057,
+        -0.16940696557660284,
+        -0.2824576693367504,
+        0.768385654396434,
+        0.9154624079279825,
+        -0.6981581884177821,
+        -0.6475645430192594,
+        -0.5360862663609285,
+        -0.5333278326382778,
+    ];
+
+    fn field(numbers: &[f64]) -> LieField<f64> {
+        LieField::new(&Invariant::from_numbers(numbers).unwrap())
+    }
+
+    fn v3(x: [f64; 3]) -> Vec3<f64> {
+        Vec3::new(x[0], x[1], x[2])
+    }
+
+    /// The chord from `p` to `q` in [`drift_free_chord`]'s terms: its unit direction `c`,
+    /// `v0`, `n`, `κ`, and the residual of `G = (v(p) + 4 v(m) + v(q)) · c` relative to
+    /// the size of its terms.
+    fn simpson_residual(field: &LieField<f64>, p: &Vec3<f64>, q: &Vec3<f64>) -> f64 {
+        let c = (q - p).normalize().unwrap().0;
+        let m = p.add_scaled(&0.5, &(q - p));
+        let [a, b, e] = [p, &m, q].map(|x| field.normal(x));
+        let sum = (&(&a + &b.scale(&4.0)) + &e).dot(&c);
+        sum.abs() / (a.norm() + 4.0 * b.norm() + e.norm())
+    }
+
+    /// Everything `step` computes before the chord, at `p` with tangent direction `w_prev`.
+    fn chord_inputs(
+        field: &LieField<f64>,
+        p: &Vec3<f64>,
+        w_prev: &Vec3<f64>,
+    ) -> (Vec3<f64>, Vec3<f64>, Vec3<f64>, f64) {
+        let (v, n, vlen) = unit_normal(field, p).unwrap();
+        let w = project_tangent(w_prev, &n).unwrap();
+        let (_, jw) = field.normal_and_jvp(p, &w);
+        let kappa = w.dot(&jw) / vlen;
+        (v, n, w, kappa)
+    }
+
+    #[test]
+    fn a_step_whose_chord_has_no_root_is_halved_until_it_has_one() {
+        let field = field(&RANDOM_A);
+        let params = MeshParams {
+            beta_min: 16f64.to_radians(),
+            beta_max: 32f64.to_radians(),
+            ..MeshParams::default()
+        };
+        let cfg = StepConfig::<f64>::new(&params);
+        let p = v3([
+            -0.004854785907410673,
+            0.0044867633902178315,
+            0.003084307137036411,
+        ]);
+        let w_prev = v3([
+            -0.7840986856676593,
+            0.41659246178787296,
+            -0.46004344568287137,
+        ]);
+        // The length the band asks for: Newton finds no root there.
+        let chosen = 0.022763110203215635;
+        let (v, n, w, kappa) = chord_inputs(&field, &p, &w_prev);
+        let full = drift_free_chord(&field, &cfg, &p, &v, &n, &w, &chosen, &kappa).unwrap();
+        assert!(!full.converged);
+        assert!(simpson_residual(&field, &p, &full.point) > 1e-3);
+
+        let s = step(&field, &cfg, &p, &w_prev, &params.dt).unwrap();
+        assert_eq!(s.limit, StepLimit::Budget);
+        assert!(s.dt < chosen && s.dt >= chosen / 8.0, "{}", s.dt);
+        assert!(((&s.point - &p).norm() - s.dt).abs() <= 1e-15);
+        assert!(simpson_residual(&field, &p, &s.point) <= 1e-14);
+    }
+
+    #[test]
+    fn an_inserted_point_whose_chord_has_no_root_is_refused() {
+        let field = field(&RANDOM_B);
+        let cfg = StepConfig::<f64>::new(&MeshParams::default());
+        let p = v3([
+            -0.04993907333125075,
+            -0.01103549756507502,
+            0.019740638468274334,
+        ]);
+        let dir = v3([
+            -0.657016916014753,
+            -0.056215121850791056,
+            0.09663218032426707,
+        ]);
+        let stop = step_fixed(&field, &cfg, &p, &dir, &0.33323008047310865).unwrap_err();
+        assert_eq!(stop, StepStop::NoChord);
+        // A tenth of the way has a root, and the point is placed.
+        let q = step_fixed(&field, &cfg, &p, &dir, &0.033323008047310865).unwrap();
+        assert!(simpson_residual(&field, &p, &q) <= 1e-14);
+    }
+
+    /// Where the field is large, `G` carries rounding noise above the tolerance and Newton's
+    /// corrections jump between values near 3e-15 (about twice the tolerance for φ ≈ 0.1): the
+    /// solve used to spend all 64 iterations there and mark the step as budget-limited.
+    #[test]
+    fn a_chord_at_the_rounding_floor_stops_without_spending_the_budget() {
+        let field = field(&RANDOM_B);
+        let cfg = StepConfig::<f64>::new(&MeshParams::default());
+        let p = v3([
+            -1.4453399213738807,
+            -2.3699200997477745,
+            -0.8339886987957766,
+        ]);
+        let w = v3([
+            -0.6101524646644646,
+            -0.013585284404352206,
+            0.792167539041794,
+        ]);
+        let (v, n, w, kappa) = chord_inputs(&field, &p, &w);
+        let length = 0.011841414060809012;
+        let chord = drift_free_chord(&field, &cfg, &p, &v, &n, &w, &length, &kappa).unwrap();
+        assert!(chord.converged);
+        assert!(chord.iterations <= 8, "{}", chord.iterations);
+        let r = simpson_residual(&field, &p, &chord.point);
+        assert!(r <= 1e-13, "{r:e}");
     }
 
     #[test]
