@@ -513,43 +513,11 @@ fn close_hole(
         .collect();
     // Chart 1 lies to the left of the front, so seen from outside the hole the front runs
     // clockwise; when its projection does not (a curve overshot the hole), triangles that are
-    // counter-clockwise in the projection would disagree with chart 1's orientation.
-    if !simple_polygon(&proj) || signed_area(&proj) >= 0.0 {
+    // counter-clockwise in the projection would disagree with chart 1's orientation, and
+    // ears are cut instead.
+    let Some(out) = reopen::fill_flat(front, m, &proj) else {
         return clip_ears(front, pos, normals, existing);
-    }
-    let vertices: Vec<ChartVertex> = proj
-        .iter()
-        .enumerate()
-        .map(|(i, c)| ChartVertex {
-            position: Point2::new(c[0], c[1]),
-            index: i as u32,
-        })
-        .collect();
-    let edges: Vec<[usize; 2]> = (0..m).map(|i| [i, (i + 1) % m]).collect();
-    let mut conflict = false;
-    let Ok(cdt) =
-        ConstrainedDelaunayTriangulation::<ChartVertex>::try_bulk_load_cdt(vertices, edges, |_| {
-            conflict = true
-        })
-    else {
-        return Vec::new();
     };
-    if conflict || cdt.num_vertices() != m {
-        return clip_ears(front, pos, normals, existing);
-    }
-    let mut out = Vec::new();
-    for face in cdt.inner_faces() {
-        let [a, b, c] = face.vertices();
-        let (pa, pb, pc) = (a.position(), b.position(), c.position());
-        let centroid = [(pa.x + pb.x + pc.x) / 3.0, (pa.y + pb.y + pc.y) / 3.0];
-        if point_in_polygon(&proj, centroid) {
-            out.push([
-                front[a.data().index as usize],
-                front[b.data().index as usize],
-                front[c.data().index as usize],
-            ]);
-        }
-    }
     // A diagonal of the hole that chart 1 already has as an edge would make the mesh
     // non-manifold: cut ears instead, which never repeat an edge.
     let mut have: EdgeSet = edges_among(existing, front, pos.len())

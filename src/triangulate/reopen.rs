@@ -419,7 +419,12 @@ fn fill_polygon(
 ) -> Option<Vec<[u32; 3]>> {
     let all: Vec<u32> = lp.iter().chain(inside).copied().collect();
     let proj = flatten(&all, pos, normals, chart)?;
-    let m = lp.len();
+    fill_flat(&all, lp.len(), &proj)
+}
+
+/// [`fill_polygon`] once laid flat: `all` starts with the loop's `m` vertices, and `proj`
+/// holds the flat position of each of `all`.
+pub(super) fn fill_flat(all: &[u32], m: usize, proj: &[[f64; 2]]) -> Option<Vec<[u32; 3]>> {
     let polygon = &proj[..m];
     if !simple_polygon(polygon) || signed_area(polygon) >= 0.0 {
         return None;
