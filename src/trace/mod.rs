@@ -58,8 +58,9 @@ pub enum StepStop {
     /// The new point is not finite.
     NonFinite,
     /// Default mode: the drift-free chord's Newton solve found no root within its budget,
-    /// at the step's length nor at any of its [`CHORD_HALVINGS`] halvings (the field turns
-    /// too fast there for a chord to balance it, as on fields far from integrable).
+    /// at the step's length nor at up to [`CHORD_HALVINGS`] halvings of it above `dt_min`
+    /// (the field turns too fast there for a chord to balance it, as on fields far from
+    /// integrable).
     NoChord,
 }
 
@@ -67,9 +68,9 @@ pub enum StepStop {
 /// no root, before the curve ends with [`StepStop::NoChord`].
 pub const CHORD_HALVINGS: u32 = 3;
 
-/// A Newton correction that stops shrinking (by half or more) within this many tolerances is
-/// the rounding floor of the chord equation: `G` is evaluated with rounding noise, and the
-/// corrections then jump between a few values just above the tolerance.
+/// A Newton correction within this many tolerances that is more than half the one before it
+/// marks the rounding floor of the chord equation: `G` is evaluated with rounding noise, and
+/// the corrections then jump between a few values just above the tolerance.
 const STALL_TOLERANCES: f64 = 64.0;
 
 /// Which limit, if any, an accepted step ran into.
@@ -217,14 +218,13 @@ pub fn step<T: Scalar, F: NormalField<T>>(
             let mut iterations = chord.iterations;
             // No root near the osculating circle's chord: the field turns too fast over Δt.
             // A shorter chord turns less; the step is marked as limited by the budget.
-            for halving in 1..=CHORD_HALVINGS + 1 {
-                if chord.converged {
-                    break;
-                }
+            let mut halvings = 0;
+            while !chord.converged {
                 let half = dt.clone() * T::from_f64(0.5);
-                if halving > CHORD_HALVINGS || half < cfg.dt_min {
+                if halvings == CHORD_HALVINGS || half < cfg.dt_min {
                     return Err(StepStop::NoChord);
                 }
+                halvings += 1;
                 dt = half;
                 limit = StepLimit::Budget;
                 chord = drift_free_chord(field, cfg, p, &v, &n, &w, &dt, &kappa)?;
