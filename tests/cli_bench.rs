@@ -44,6 +44,17 @@ fn bench_json_has_keys_and_positive_numbers() {
         let x = v["ratios"][key].as_f64().unwrap_or(-1.0);
         assert!(x > 0.0 && x.is_finite(), "{key} = {x}");
     }
+    // The fidelity rows say which β band and insertion gap they found (or came closest with).
+    let fidelity = v["fidelity"].as_array().expect("fidelity");
+    assert_eq!(fidelity.len(), 2);
+    for f in fidelity {
+        for key in ["beta_deg", "gap"] {
+            let pair = f[key].as_array().unwrap_or_else(|| panic!("{key} in {f}"));
+            assert_eq!(pair.len(), 2, "{f}");
+            assert!(pair.iter().all(|x| x.as_f64().unwrap() > 0.0), "{f}");
+        }
+        assert!(f["max_error_deg"].as_f64().unwrap() > 0.0, "{f}");
+    }
     // Each target the run covers is judged: a limit, a verdict, and a measured value that is
     // a positive number or, for an unreached fidelity limit, null.
     let targets = v["targets"].as_array().expect("targets");
