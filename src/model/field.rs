@@ -41,8 +41,9 @@ pub trait NormalField<T: Scalar>: Sync {
     ///
     /// Solvers use it for a cheap first guess that they then refine in `T` to `T`'s own
     /// tolerance, so the result does not depend on it beyond rounding: the drift-free chord
-    /// finds its angle in `f64` and then needs about three Newton iterations at 256 bits
-    /// instead of five or six. The default, `None`, runs every iteration in `T`.
+    /// finds its angle in `f64` and then needs one Newton iteration with Jacobian-vector
+    /// products at 256 bits, and one or two with field values only, instead of four or five
+    /// with products. The default, `None`, runs every iteration in `T`.
     fn in_f64(&self) -> Option<&dyn NormalField<f64>> {
         None
     }

@@ -348,9 +348,10 @@ fn drift_free_chord<T: Scalar, F: NormalField<T>>(
                 guess,
                 newton_budget,
                 Solve::Seed,
+                None,
             ) {
                 Ok(root) if root.converged && root.settled && root.iterations <= 8 => {
-                    Some(T::from_f64(root.phi))
+                    Some((T::from_f64(root.phi), root.derivative.map(T::from_f64)))
                 }
                 _ => None,
             }
@@ -364,8 +365,20 @@ fn drift_free_chord<T: Scalar, F: NormalField<T>>(
         Solve::Full
     };
     // Initial guess without a seed: the chord of the osculating circle, φ ≈ −κL/2.
-    let guess = seed.unwrap_or_else(|| -(kappa.clone() * (length.clone() * T::from_f64(0.5))));
-    let root = chord_angle(field, p, v0, n, w, length, guess, newton_budget, solve)?;
+    let (guess, derivative) =
+        seed.unwrap_or_else(|| (-(kappa.clone() * (length.clone() * T::from_f64(0.5))), None));
+    let root = chord_angle(
+        field,
+        p,
+        v0,
+        n,
+        w,
+        length,
+        guess,
+        newton_budget,
+        solve,
+        derivative,
+    )?;
     let mut direction = w.scale(&root.cos);
     direction.add_scaled_assign(&root.sin, n);
     let point = p.add_scaled(length, &direction);
@@ -402,6 +415,8 @@ struct ChordAngle<T> {
     /// Every correction after the first was smaller than the one before it (not watched,
     /// so `true`, for [`Solve::Full`]).
     settled: bool,
+    /// [`Solve::Seed`] only: `G'` from the last iteration, for the refinement's first step.
+    derivative: Option<T>,
 }
 
 /// Newton's method for the chord angle from `phi`.
@@ -431,6 +446,7 @@ fn chord_angle<T: Scalar, F: NormalField<T>>(
     mut phi: T,
     budget: usize,
     solve: Solve,
+    seed_derivative: Option<T>,
 ) -> Result<ChordAngle<T>, StepStop> {
     let refining = solve == Solve::Refine;
     let four = T::from_f64(4.0);
@@ -442,7 +458,12 @@ fn chord_angle<T: Scalar, F: NormalField<T>>(
     // The last correction's size. Refine only: the derivative to keep, with the error factor
     // `2C δ` it carries, when the next step is the last, value-only one.
     let mut previous = f64::INFINITY;
-    let mut keep: Option<(T, f64)> = None;
+    // A seed's own `G'` (good to `f64`) serves the first step, value-only: from a seed good
+    // to `f64` that step gains as many digits as a Newton step would (its error is the
+    // seed's times the derivative's relative error), and saves two JVPs. It never ends the
+    // solve (no previous correction to judge it by).
+    let mut keep: Option<(T, f64)> = seed_derivative.map(|d| (d, f64::INFINITY));
+    let mut derivative = None;
     let (mut iterations, mut converged, mut settled) = (0, false, true);
     while !converged && (iterations as usize) < budget {
         iterations += 1;
@@ -471,6 +492,9 @@ fn chord_angle<T: Scalar, F: NormalField<T>>(
                 let mut dsum = jm.scale(&middle_weight); // 4 (L/2) jm + L j1
                 dsum.add_scaled_assign(length, &j1);
                 let dg = sum.dot(&perp) + dsum.dot(&dir);
+                if solve == Solve::Seed {
+                    derivative = Some(dg.clone());
+                }
                 (sum, dg)
             }
         };
@@ -534,6 +558,7 @@ fn chord_angle<T: Scalar, F: NormalField<T>>(
         iterations,
         converged,
         settled,
+        derivative,
     })
 }
 
@@ -834,6 +859,50 @@ mod tests {
                 fewer, steps,
                 "{preset}: the seed saves iterations at every step"
             );
+        }
+    }
+
+    /// Counts the Jacobian-vector products evaluated in `T`; offers the field's `f64` copy.
+    #[cfg(feature = "mpfr")]
+    struct CountingJvps<F>(F, std::sync::atomic::AtomicUsize);
+
+    #[cfg(feature = "mpfr")]
+    impl<T: Scalar, F: NormalField<T>> NormalField<T> for CountingJvps<F> {
+        fn normal(&self, p: &Vec3<T>) -> Vec3<T> {
+            self.0.normal(p)
+        }
+        fn normal_and_jvp(&self, p: &Vec3<T>, w: &Vec3<T>) -> (Vec3<T>, Vec3<T>) {
+            self.1.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+            self.0.normal_and_jvp(p, w)
+        }
+        fn in_f64(&self) -> Option<&dyn NormalField<f64>> {
+            self.0.in_f64()
+        }
+    }
+
+    /// The seed's own `G'` takes the refinement's first step, so a 256-bit chord needs one
+    /// Newton iteration with Jacobian-vector products (two of them, at the chord's middle and
+    /// end) besides the step's own at `p`; the other iterations use field values only.
+    #[cfg(feature = "mpfr")]
+    #[test]
+    fn a_seeded_chord_makes_one_newton_iteration_with_jvps_at_256_bits() {
+        use crate::scalar::Mpfr;
+        type M = Mpfr<256>;
+        for preset in [Preset::Fig3, Preset::Fig6] {
+            let field = CountingJvps(LieField::<M>::new(&preset.invariant()), Default::default());
+            let params = preset.params();
+            let cfg = StepConfig::<M>::new(&params);
+            let mut p = Vec3::<M>::from_f64(params.p0);
+            let mut w = Vec3::<M>::from_f64([1.0, 0.0, 0.0]);
+            let dt = M::from_f64(params.dt);
+            for _ in 0..12 {
+                field.1.store(0, std::sync::atomic::Ordering::Relaxed);
+                let s = step(&field, &cfg, &p, &w, &dt).unwrap();
+                let jvps = field.1.load(std::sync::atomic::Ordering::Relaxed);
+                assert_eq!(jvps, 1 + 2, "{preset}");
+                assert!(s.iterations >= 2, "{preset}: {}", s.iterations);
+                (p, w) = (s.point, s.carry);
+            }
         }
     }
 
