@@ -119,13 +119,27 @@ pub fn triangulate<T: Scalar>(
     // The finished triangles, once some closing (or none) is settled on.
     let mut finished = None;
     if !closing.is_empty() {
-        let (all, folded) = finish(triangles.clone(), &closing);
         // Closing triangles across a thin, twisted hole can face against the field, and flips
-        // cannot always turn them round: then the hole stays open rather than folded.
-        if still_folds(&all, folded) {
+        // cannot always turn them round: then the hole stays open rather than folded. When
+        // flips around the hole already leave a fold there, the pass over the whole mesh
+        // would end the same way and is spared.
+        let local = improve && folds_near_the_hole(&triangles, &closing, &pos, &normals);
+        debug_assert!(
+            !local || {
+                let (all, folded) = finish(triangles.clone(), &closing);
+                still_folds(&all, folded)
+            },
+            "a closing that folds near the hole was unfolded by the whole mesh's flips"
+        );
+        if local {
             closing.clear();
         } else {
-            finished = Some(all);
+            let (all, folded) = finish(triangles.clone(), &closing);
+            if still_folds(&all, folded) {
+                closing.clear();
+            } else {
+                finished = Some(all);
+            }
         }
     }
     // A hole that would not close because chart 1 folds next to it (curves crossing a
@@ -586,6 +600,44 @@ fn frame_around(normals: impl Iterator<Item = [f64; 3]>) -> Option<[[f64; 3]; 3]
     };
     let f1 = normalize3(cross3(helper, nm));
     Some([f1, cross3(nm, f1), nm])
+}
+
+/// Rings of chart-1 vertices around a closing that [`folds_near_the_hole`] flips with it.
+const HOLE_RINGS: usize = 4;
+
+/// Whether the closing still folds after surface-Delaunay flips among its own triangles and
+/// the chart-1 triangles within [`HOLE_RINGS`] rings of its vertices (a small part of the
+/// mesh). Flips elsewhere do not reach a fold there, so the flip pass over the whole mesh
+/// would leave it too (debug builds check that); `false` also when the region is not a
+/// manifold the pass can flip.
+fn folds_near_the_hole(
+    chart: &[[u32; 3]],
+    closing: &[[u32; 3]],
+    pos: &[[f64; 3]],
+    normals: &[[f64; 3]],
+) -> bool {
+    let mut near = vec![false; pos.len()];
+    for &v in closing.iter().flatten() {
+        near[v as usize] = true;
+    }
+    let touches = |t: &[u32; 3], near: &[bool]| t.iter().any(|&v| near[v as usize]);
+    for _ in 0..HOLE_RINGS {
+        let mut grown = near.clone();
+        for t in chart.iter().filter(|t| touches(t, &near)) {
+            for &v in t {
+                grown[v as usize] = true;
+            }
+        }
+        near = grown;
+    }
+    let mut region: Vec<[u32; 3]> = chart
+        .iter()
+        .filter(|t| touches(t, &near))
+        .copied()
+        .collect();
+    region.extend_from_slice(closing);
+    let budget = 8 * region.len() + 64;
+    flip::flip_to_surface_delaunay(pos, normals, &mut region, budget).folded == Some(true)
 }
 
 /// Whether any of `triangles` faces against the field normal at its corners (a closing
