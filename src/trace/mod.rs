@@ -214,7 +214,13 @@ pub fn step<T: Scalar, F: NormalField<T>>(
                 limit = StepLimit::Clamped;
             }
             let kappa = w.dot(&jw) / vlen.clone();
-            let mut chord = drift_free_chord(field, cfg, p, &v, &n, &w, &dt, &kappa)?;
+            let start = ChordStart {
+                p,
+                v0: &v,
+                n: &n,
+                w: &w,
+            };
+            let mut chord = drift_free_chord(field, cfg, &start, &dt, &kappa)?;
             let mut iterations = chord.iterations;
             // No root near the osculating circle's chord: the field turns too fast over Δt.
             // A shorter chord turns less; the step is marked as limited by the budget.
@@ -227,7 +233,7 @@ pub fn step<T: Scalar, F: NormalField<T>>(
                 halvings += 1;
                 dt = half;
                 limit = StepLimit::Budget;
-                chord = drift_free_chord(field, cfg, p, &v, &n, &w, &dt, &kappa)?;
+                chord = drift_free_chord(field, cfg, &start, &dt, &kappa)?;
                 iterations += chord.iterations;
             }
             // α only reports on the closed-form Δt here, so `f64` is enough (and it is the
@@ -287,7 +293,13 @@ pub fn step_fixed<T: Scalar, F: NormalField<T>>(
         Mode::Default => {
             let (_, jw) = field.normal_and_jvp(p, &w);
             let kappa = w.dot(&jw) / vlen;
-            let chord = drift_free_chord(field, cfg, p, &v, &n, &w, length, &kappa)?;
+            let start = ChordStart {
+                p,
+                v0: &v,
+                n: &n,
+                w: &w,
+            };
+            let chord = drift_free_chord(field, cfg, &start, length, &kappa)?;
             if chord.converged {
                 Ok(chord.point)
             } else {
@@ -305,6 +317,15 @@ struct Chord<T> {
     converged: bool,
 }
 
+/// Where a chord starts: at `p`, with the field `v0` and its unit normal `n` there, along the
+/// unit tangent `w`.
+struct ChordStart<'a, T> {
+    p: &'a Vec3<T>,
+    v0: &'a Vec3<T>,
+    n: &'a Vec3<T>,
+    w: &'a Vec3<T>,
+}
+
 /// The chord `p + L c`, `c = cos φ w + sin φ n`, with `φ` solving
 /// `G(φ) = (v(p) + 4 v(p + L c/2) + v(p + L c)) · c = 0` by Newton's method.
 ///
@@ -316,22 +337,25 @@ struct Chord<T> {
 /// When `T` is more precise than `f64` and the field offers [`NormalField::in_f64`], `φ` is
 /// first solved in `f64` and then refined in `T`; otherwise Newton starts from the chord of
 /// the osculating circle.
-#[allow(clippy::too_many_arguments)]
 fn drift_free_chord<T: Scalar, F: NormalField<T>>(
     field: &F,
     cfg: &StepConfig<T>,
-    p: &Vec3<T>,
-    v0: &Vec3<T>,
-    n: &Vec3<T>,
-    w: &Vec3<T>,
+    start: &ChordStart<T>,
     length: &T,
     kappa: &T,
 ) -> Result<Chord<T>, StepStop> {
+    let &ChordStart { p, v0, n, w } = start;
     let newton_budget = cfg.max_retries.clamp(4, 64);
     let seed = if T::unit_roundoff() < f64::unit_roundoff() {
         field.in_f64().and_then(|f64_field| {
             let [p, v0, n, w] = [p, v0, n, w].map(|x| Vec3::from_f64(x.to_f64()));
             let (length, kappa) = (length.to_f64(), kappa.to_f64());
+            let start = ChordStart {
+                p: &p,
+                v0: &v0,
+                n: &n,
+                w: &w,
+            };
             let guess = -(kappa * (0.5 * length));
             // Only a solve that converged the way Newton does near its root (every correction
             // smaller than the one before, in a few iterations) seeds `T`: started from the
@@ -340,10 +364,7 @@ fn drift_free_chord<T: Scalar, F: NormalField<T>>(
             // would, so `T` then starts from the guess itself, as without a seed.
             match chord_angle(
                 &f64_field,
-                &p,
-                &v0,
-                &n,
-                &w,
+                &start,
                 &length,
                 guess,
                 newton_budget,
@@ -369,10 +390,7 @@ fn drift_free_chord<T: Scalar, F: NormalField<T>>(
         seed.unwrap_or_else(|| (-(kappa.clone() * (length.clone() * T::from_f64(0.5))), None));
     let root = chord_angle(
         field,
-        p,
-        v0,
-        n,
-        w,
+        start,
         length,
         guess,
         newton_budget,
@@ -398,7 +416,7 @@ fn drift_free_chord<T: Scalar, F: NormalField<T>>(
 enum Solve {
     /// From the osculating circle's guess to the tolerance, every iteration in `T`.
     Full,
-    /// As `Full`, in `f64`, for a seed: also watches whether the corrections settle.
+    /// As `Full`, in `f64`, for a seed: also keeps the last derivative `G'`.
     Seed,
     /// Refining a seed good to `f64` (predicted stops, a value-only last step, rotated
     /// sine and cosine).
@@ -412,8 +430,8 @@ struct ChordAngle<T> {
     cos: T,
     iterations: u32,
     converged: bool,
-    /// Every correction after the first was smaller than the one before it (not watched,
-    /// so `true`, for [`Solve::Full`]).
+    /// Every correction after the first was smaller than the one before it (what a seed
+    /// needs, see [`drift_free_chord`]).
     settled: bool,
     /// [`Solve::Seed`] only: `G'` from the last iteration, for the refinement's first step.
     derivative: Option<T>,
@@ -435,19 +453,16 @@ struct ChordAngle<T> {
 ///   products, and stops if the correction it measures bears that out;
 /// - it rotates the sine and cosine by each correction `δ` instead of evaluating them at
 ///   the new `φ` (equal to rounding; the series for a tiny `δ` is short at 256 bits).
-#[allow(clippy::too_many_arguments)]
 fn chord_angle<T: Scalar, F: NormalField<T>>(
     field: &F,
-    p: &Vec3<T>,
-    v0: &Vec3<T>,
-    n: &Vec3<T>,
-    w: &Vec3<T>,
+    start: &ChordStart<T>,
     length: &T,
     mut phi: T,
     budget: usize,
     solve: Solve,
     seed_derivative: Option<T>,
 ) -> Result<ChordAngle<T>, StepStop> {
+    let &ChordStart { p, v0, n, w } = start;
     let refining = solve == Solve::Refine;
     let four = T::from_f64(4.0);
     let half_len = length.clone() * T::from_f64(0.5);
@@ -522,10 +537,6 @@ fn chord_angle<T: Scalar, F: NormalField<T>>(
         // converges at all, so the check waits for the fourth.
         if !converged && iterations >= 4 {
             converged = d <= STALL_TOLERANCES * limit.to_f64() && d > 0.5 * previous;
-        }
-        if solve == Solve::Full {
-            previous = d;
-            continue;
         }
         settled &= d < previous;
         if refining && !converged {
@@ -735,7 +746,13 @@ mod tests {
         // The length the band asks for: Newton finds no root there.
         let chosen = 0.022763110203215635;
         let (v, n, w, kappa) = chord_inputs(&field, &p, &w_prev);
-        let full = drift_free_chord(&field, &cfg, &p, &v, &n, &w, &chosen, &kappa).unwrap();
+        let start = ChordStart {
+            p: &p,
+            v0: &v,
+            n: &n,
+            w: &w,
+        };
+        let full = drift_free_chord(&field, &cfg, &start, &chosen, &kappa).unwrap();
         assert!(!full.converged);
         assert!(simpson_residual(&field, &p, &full.point) > 1e-3);
 
@@ -786,7 +803,13 @@ mod tests {
         ]);
         let (v, n, w, kappa) = chord_inputs(&field, &p, &w);
         let length = 0.011841414060809012;
-        let chord = drift_free_chord(&field, &cfg, &p, &v, &n, &w, &length, &kappa).unwrap();
+        let start = ChordStart {
+            p: &p,
+            v0: &v,
+            n: &n,
+            w: &w,
+        };
+        let chord = drift_free_chord(&field, &cfg, &start, &length, &kappa).unwrap();
         assert!(chord.converged);
         assert!(chord.iterations <= 8, "{}", chord.iterations);
         let r = simpson_residual(&field, &p, &chord.point);

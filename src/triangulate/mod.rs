@@ -209,8 +209,7 @@ const TIE_BREAK: f64 = 1.0 / (1u64 << 30) as f64;
 /// # Ok::<(), liemesh::MeshError>(())
 /// ```
 pub fn chart_points<T: Scalar>(samples: &Samples<T>) -> Vec<[f64; 2]> {
-    let mut order: Vec<usize> = (0..samples.curves.len()).collect();
-    order.sort_by(|&a, &b| samples.curves[a].theta.total_cmp(&samples.curves[b].theta));
+    let order = curves_by_theta(samples);
     // Pushed out (+1), pulled in (−1), or, closing an odd number of curves, left in place:
     // any two neighbours differ.
     let mut push = vec![0.0; samples.curves.len()];
@@ -234,6 +233,13 @@ pub fn chart_points<T: Scalar>(samples: &Samples<T>) -> Vec<[f64; 2]> {
             [x * f, y * f]
         })
         .collect()
+}
+
+/// The curves' indices in order of their angle θ at `p0` (ties by index).
+fn curves_by_theta<T>(samples: &Samples<T>) -> Vec<usize> {
+    let mut order: Vec<usize> = (0..samples.curves.len()).collect();
+    order.sort_by(|&a, &b| samples.curves[a].theta.total_cmp(&samples.curves[b].theta));
+    order
 }
 
 /// Rejects samples that [`sample`](crate::sample::sample) cannot produce but a caller who
@@ -285,8 +291,7 @@ fn check_samples<T: Scalar>(samples: &Samples<T>) -> Result<(), MeshError> {
 /// curves that lie inside the polygon of their neighbours (those curves stopped between two
 /// that went on, and the region beyond their end belongs to the mesh).
 fn front_polygon<T: Scalar>(samples: &Samples<T>, chart: &[[f64; 2]]) -> Vec<u32> {
-    let mut order: Vec<usize> = (0..samples.curves.len()).collect();
-    order.sort_by(|&a, &b| samples.curves[a].theta.total_cmp(&samples.curves[b].theta));
+    let order = curves_by_theta(samples);
     let mut poly: Vec<(u32, bool)> = order
         .iter()
         .map(|&c| {
