@@ -26,7 +26,7 @@ use crate::scalar::f64x3::{cross as cross3, sub as sub3};
 use crate::scalar::Vec3;
 use crate::trace::StepLimit;
 use crate::triangulate::{ChartTriangulation, Mesh, Provenance};
-use crate::{Budget, MeshError, MeshParams, MeshRun, Method, Mode};
+use crate::{Budget, MeshError, MeshParams, MeshRun, Method, Mode, NormalField};
 use arbitrary::{Arbitrary, Unstructured};
 use std::collections::{HashMap, HashSet};
 use std::fmt;
@@ -250,7 +250,13 @@ pub struct MesherInput {
     pub terminal: [Num; 2],
     /// Budgets.
     pub budget: BudgetInput,
+    /// Refinement to a normal-error bound, derived from [`FUZZ_NORMAL_ERROR_DEG`] (`None`:
+    /// none, what an exhausted input decodes to).
+    pub refine: Option<Num>,
 }
+
+/// The normal-error bound, degrees, that [`MesherInput::refine`] derives its bound from.
+pub const FUZZ_NORMAL_ERROR_DEG: f64 = 2.0;
 
 impl MesherInput {
     /// The preset the numbers are derived from.
@@ -309,6 +315,9 @@ impl MesherInput {
                 close: self.close.unwrap_or(base.terminal.close),
             },
             budget: self.budget.budget(),
+            max_normal_error: self
+                .refine
+                .map(|n| n.apply(FUZZ_NORMAL_ERROR_DEG.to_radians())),
         }
     }
 }
@@ -346,7 +355,7 @@ pub fn mesher(data: &[u8]) -> Result<(), Violation> {
     let params = input.params();
     let field = LieField::<f64>::new(&invariant);
     let result = crate::run(&field, &params);
-    check_run(&params, &result).map_err(|v| Violation(format!("{v}\ninput: {input:?}")))
+    check_run(&field, &params, &result).map_err(|v| Violation(format!("{v}\ninput: {input:?}")))
 }
 
 /// Checks everything a meshing run promises:
@@ -359,8 +368,11 @@ pub fn mesher(data: &[u8]) -> Result<(), Violation> {
 /// - the mesh satisfies [`check_mesh`] (no NaN, no degenerate or duplicate triangles, manifold,
 ///   consistently oriented), has at most as many triangles as the chart and closing
 ///   triangulations (triangles of no area in space are left out), and its vertices are the
-///   run's working-precision vertices rounded to `f64`.
+///   run's working-precision vertices rounded to `f64`;
+/// - refinement ([`MeshParams::max_normal_error`]) counts the vertices it added and the faces
+///   of `field` it left over the bound correctly, and adds at most two faces per vertex.
 pub fn check_run(
+    field: &impl NormalField<f64>,
     params: &MeshParams,
     result: &Result<MeshRun<f64>, MeshError>,
 ) -> Result<(), Violation> {
@@ -409,13 +421,37 @@ pub fn check_run(
         run.vertices.len(),
         run.mesh.vertices.len()
     );
+    // Each vertex that refinement added split one or two faces in two.
+    let refined = (run.mesh.provenance.iter())
+        .filter(|p| p.curve == Provenance::REFINED_CURVE)
+        .count();
     ensure!(
-        run.mesh.triangles.len() <= run.chart.triangles.len() + run.chart.closing.len(),
-        "the mesh has {} triangles, more than the charts' {} + {}",
+        run.refinement.map_or(0, |r| r.added) == refined,
+        "refinement says it added {:?} vertices, the mesh has {refined}",
+        run.refinement
+    );
+    ensure!(
+        run.mesh.triangles.len()
+            <= run.chart.triangles.len() + run.chart.closing.len() + 2 * refined,
+        "the mesh has {} triangles, more than the charts' {} + {} and two per refined vertex ({refined})",
         run.mesh.triangles.len(),
         run.chart.triangles.len(),
         run.chart.closing.len()
     );
+    if let (Some(limit), Some(r)) = (params.max_normal_error, run.refinement) {
+        let over = (run.mesh.triangles.iter())
+            .filter(|t| {
+                let corners = t.map(|i| run.mesh.vertices[i as usize]);
+                crate::quality::face_error_deg(corners, |c| field.normal(c)) > limit.to_degrees()
+            })
+            .count();
+        ensure!(
+            over == r.over_limit,
+            "refinement says {} faces are over {}°, the mesh has {over}",
+            r.over_limit,
+            limit.to_degrees()
+        );
+    }
     Ok(())
 }
 

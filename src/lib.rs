@@ -64,6 +64,8 @@ pub struct MeshRun<T> {
     pub mesh: Mesh,
     /// The mesh's vertices in the working precision (`mesh.vertices` rounded to `f64`).
     pub vertices: Vec<scalar::Vec3<T>>,
+    /// What refinement to [`MeshParams::max_normal_error`] did, if it was asked for.
+    pub refinement: Option<triangulate::Refinement>,
 }
 
 /// Samples and triangulates the surface of `field` (the whole pipeline), keeping the
@@ -79,7 +81,7 @@ pub fn run<T: Scalar, F: NormalField<T>>(
     let samples = sample::sample(field, params)?;
     let improve = params.mode == Mode::Default;
     let (mut mesh, chart) = triangulate::triangulate(&samples, params.terminal.close, improve)?;
-    let vertices = if improve {
+    let mut vertices = if improve {
         triangulate::relax(field, params, &samples, &mut mesh)
     } else {
         mesh.provenance
@@ -90,11 +92,15 @@ pub fn run<T: Scalar, F: NormalField<T>>(
             })
             .collect()
     };
+    let refinement = params.max_normal_error.map(|limit| {
+        triangulate::refine(field, params, limit.to_degrees(), &mut mesh, &mut vertices)
+    });
     Ok(MeshRun {
         samples,
         chart,
         mesh,
         vertices,
+        refinement,
     })
 }
 

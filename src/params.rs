@@ -118,6 +118,11 @@ pub struct MeshParams {
     pub terminal: Terminal,
     /// Budgets.
     pub budget: Budget,
+    /// Refinement: split faces whose normal error (the angle between the face and the field
+    /// normal at its centroid) exceeds this many radians, after the mesh is built. `None`
+    /// (the presets' choice) leaves the mesh as built.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub max_normal_error: Option<f64>,
 }
 
 impl Default for MeshParams {
@@ -207,6 +212,16 @@ impl MeshParams {
                 value: self.merge,
                 why: "the merge threshold must lie in [0, gap/2) step lengths",
             });
+        }
+        if let Some(e) = self.max_normal_error {
+            finite("max_normal_error", e)?;
+            if !(e > 0.0 && e < std::f64::consts::FRAC_PI_2) {
+                return Err(MeshError::OutOfRange {
+                    name: "max_normal_error_deg",
+                    value: e.to_degrees(),
+                    why: "the bound on the face-normal error must lie strictly between 0° and 90°",
+                });
+            }
         }
         if self.terminal.max_radius <= 0.0 {
             return Err(MeshError::OutOfRange {

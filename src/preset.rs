@@ -124,6 +124,7 @@ impl Preset {
                 close: true,
             },
             budget: Budget::default(),
+            max_normal_error: None,
         }
     }
 }

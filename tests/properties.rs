@@ -60,7 +60,7 @@ fn run_cases(
             .map_err(|e| TestCaseError::fail(format!("bad strategy: {e}")))?;
         let field = LieField::<f64>::new(&invariant);
         let result = liemesh::run(&field, &params);
-        check_run(&params, &result).map_err(|v| TestCaseError::fail(v.0))?;
+        check_run(&field, &params, &result).map_err(|v| TestCaseError::fail(v.0))?;
         match result {
             Ok(run) => {
                 ok.set(ok.get() + 1);
@@ -195,6 +195,25 @@ fn hamiltonian_invariants_give_valid_meshes_or_typed_errors() {
 }
 
 #[test]
+fn refinement_keeps_meshes_valid_and_reports_what_it_leaves() {
+    // `check_run` also counts the refined vertices and the faces over the bound, and holds
+    // them against the refinement's report.
+    let refined = (params_near(Preset::Fig3, 5_000), 0.5..6.0f64).prop_map(|(mut p, deg)| {
+        p.max_normal_error = Some(deg.to_radians());
+        p
+    });
+    let strategy = (
+        prop_oneof![linear_invariant(), hamiltonian_invariant()],
+        refined,
+    );
+    let (ok, err, split) = run_cases(96, strategy, |run| {
+        run.refinement.is_some_and(|r| r.added > 0)
+    });
+    assert_most_cases_mesh(ok, err);
+    assert!(split >= ok / 4, "only {split} of {ok} meshes were refined");
+}
+
+#[test]
 fn tight_budgets_are_respected() {
     // Budgets small enough that most runs hit one of them.
     let strategy = (
@@ -221,7 +240,7 @@ fn tight_budgets_are_respected() {
 fn invalid_parameters_give_the_validation_error() {
     // One parameter pushed out of its allowed range: the run must return exactly the error
     // `MeshParams::validate` names, for every invariant.
-    let broken = (params_near(Preset::Fig3, 2_000), 0usize..12, -2.0..2.0f64).prop_map(
+    let broken = (params_near(Preset::Fig3, 2_000), 0usize..13, -2.0..2.0f64).prop_map(
         |(mut p, which, x)| {
             match which {
                 0 => p.dt = -x.abs(),
@@ -235,6 +254,7 @@ fn invalid_parameters_give_the_validation_error() {
                 8 => p.p0[1] = f64::NAN,
                 9 => p.terminal.max_radius = -x.abs(),
                 10 => p.budget.max_points = 0,
+                11 => p.max_normal_error = Some(PI / 2.0 + x.abs()),
                 _ => p.method = Method::Previous { curves: 2 },
             }
             p
@@ -257,7 +277,7 @@ fn the_presets_themselves_pass_the_checks() {
         params.budget.max_points = 20_000;
         let field = LieField::<f64>::new(&preset.invariant());
         let result = liemesh::run(&field, &params);
-        check_run(&params, &result).unwrap_or_else(|v| panic!("{preset}: {v}"));
+        check_run(&field, &params, &result).unwrap_or_else(|v| panic!("{preset}: {v}"));
         assert!(result.is_ok(), "{preset}: {result:?}");
     }
 }

@@ -70,6 +70,7 @@ fn inserted_curves_start_inside_the_bounding_box() {
             max_steps_per_curve: 18,
             max_retries: 2,
         },
+        max_normal_error: None,
     };
     let run = liemesh::run(&LieField::<f64>::new(&invariant), &params).unwrap();
     for (i, p) in run.samples.points.iter().enumerate().skip(1) {
@@ -194,6 +195,7 @@ fn two_remaining_curves_get_one_inserted_curve_between_them() {
             max_steps_per_curve: 15,
             max_retries: 1,
         },
+        max_normal_error: None,
     };
     let run = liemesh::run(&LieField::<f64>::new(&invariant), &params).unwrap();
     let mut seen = std::collections::HashMap::new();

@@ -120,6 +120,7 @@ fn mesh_one(input: &Path, out: &Path, format: MeshFormat) -> Result<BatchDone, C
         &params,
     );
     report.quality = outcome.quality;
+    report.refinement = outcome.refinement;
     write_json(&report_path, &report)?;
     Ok(BatchDone {
         mesh: mesh_path,

@@ -142,6 +142,10 @@ pub struct Overrides {
     /// 4 to 64).
     #[arg(long)]
     pub max_retries: Option<usize>,
+    /// Refine the mesh until no face's normal deviates from the field normal at its
+    /// centroid by more than this many degrees (splits the longest edges of the worst faces)
+    #[arg(long, allow_hyphen_values = true, value_name = "DEG")]
+    pub max_normal_error: Option<f64>,
 }
 
 impl Overrides {
@@ -171,6 +175,7 @@ impl Overrides {
             max_curves: self.max_curves,
             max_steps: self.max_steps,
             max_retries: self.max_retries,
+            max_normal_error_deg: self.max_normal_error,
         }
     }
 }
@@ -256,6 +261,8 @@ pub struct MeshOutcome {
     pub seconds: f64,
     /// The quality report, when asked for.
     pub quality: Option<crate::quality::QualityReport>,
+    /// What refinement to a normal-error bound did, when asked for.
+    pub refinement: Option<crate::triangulate::Refinement>,
 }
 
 fn mesh_in<T: Scalar>(
@@ -275,6 +282,7 @@ fn mesh_in<T: Scalar>(
         mesh: run.mesh,
         seconds,
         quality,
+        refinement: run.refinement,
     })
 }
 
@@ -343,6 +351,7 @@ pub(super) fn run(args: &MeshArgs) -> Result<ExitCode, CliError> {
         &params,
     );
     report.quality = outcome.quality.clone();
+    report.refinement = outcome.refinement;
     if let Some(path) = &args.report {
         write_json(path, &report)?;
     }
@@ -412,6 +421,24 @@ fn print_summary(r: &Report, mesh: Option<&Path>, report: Option<&Path>) {
         if r.boundary_loops == 1 { "" } else { "s" }
     );
     println!("  time       {:.2} ms", r.seconds * 1e3);
+    if let (Some(f), Some(limit)) = (&r.refinement, r.parameters.max_normal_error) {
+        let limit = limit.to_degrees();
+        println!(
+            "  refinement {} vertices in {} round{}; {}",
+            f.added,
+            f.rounds,
+            if f.rounds == 1 { "" } else { "s" },
+            if f.over_limit == 0 {
+                format!("every face within {limit}° of the field normal")
+            } else {
+                format!(
+                    "{} faces still over {limit}° (the rounds or the point budget ran out, or \
+                     splits there would fold the mesh)",
+                    f.over_limit
+                )
+            }
+        );
+    }
     if let Some(m) = mesh {
         println!("  mesh       {}", m.display());
     }

@@ -107,6 +107,8 @@ pub struct ParamsPatch {
     pub max_steps: Option<usize>,
     /// Retry budget per step.
     pub max_retries: Option<usize>,
+    /// Refine faces whose normal error exceeds this many degrees.
+    pub max_normal_error_deg: Option<f64>,
 }
 
 impl ParamsPatch {
@@ -170,6 +172,9 @@ impl ParamsPatch {
         }
         if let Some(d) = self.beta_max_deg {
             params.beta_max = d.to_radians();
+        }
+        if let Some(d) = self.max_normal_error_deg {
+            params.max_normal_error = Some(d.to_radians());
         }
         Ok(())
     }

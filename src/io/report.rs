@@ -38,6 +38,9 @@ pub struct Report {
     pub parameters: MeshParams,
     /// Quality measures (shape, fidelity, topology, recovered invariant), when measured.
     pub quality: Option<crate::quality::QualityReport>,
+    /// What refinement to [`MeshParams::max_normal_error`] did, when it was asked for.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub refinement: Option<crate::triangulate::Refinement>,
 }
 
 impl Report {
@@ -67,6 +70,7 @@ impl Report {
             seconds,
             parameters: parameters.clone(),
             quality: None,
+            refinement: None,
         }
     }
 }

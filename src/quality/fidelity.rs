@@ -87,17 +87,30 @@ pub fn step_quality<T: Scalar, F: NormalField<f64>>(
 pub fn face_normal_error<F: NormalField<f64>>(field: &F, mesh: &Mesh) -> (f64, f64) {
     let (mut max, mut sum) = (0.0_f64, 0.0);
     for t in &mesh.triangles {
-        let [a, b, c] = t.map(|i| Vec3::from_f64(mesh.vertices[i as usize]));
-        let face = (&b - &a).cross(&(&c - &a));
-        let centroid = (&(&a + &b) + &c).scale(&(1.0 / 3.0));
-        let v = field.normal(&centroid);
-        let e = angle_deg(&face, &v);
-        let e = if e.is_nan() { 180.0 } else { e };
+        let e = face_error_deg(t.map(|i| mesh.vertices[i as usize]), |c| field.normal(c));
         max = max.max(e);
         sum += e;
     }
     let n = mesh.triangles.len().max(1) as f64;
     (max, sum / n)
+}
+
+/// One face's normal error: the angle in degrees between the face with `corners` and
+/// `normal_at` its centroid; 180 when that angle is NaN (a non-finite corner or field value),
+/// so that such a face counts as the worst.
+pub(crate) fn face_error_deg(
+    corners: [[f64; 3]; 3],
+    normal_at: impl FnOnce(&Vec3<f64>) -> Vec3<f64>,
+) -> f64 {
+    let [a, b, c] = corners.map(Vec3::from_f64);
+    let face = (&b - &a).cross(&(&c - &a));
+    let centroid = (&(&a + &b) + &c).scale(&(1.0 / 3.0));
+    let e = angle_deg(&face, &normal_at(&centroid));
+    if e.is_nan() {
+        180.0
+    } else {
+        e
+    }
 }
 
 /// Vertex drift from the level set through `p0`, for fields with a known potential.

@@ -9,6 +9,7 @@ mod recover;
 mod shape;
 mod topology;
 
+pub(crate) use fidelity::face_error_deg;
 pub use fidelity::{
     diagonal, drift, face_normal_error, integrability_defect, step_quality, Drift, StepQuality,
 };

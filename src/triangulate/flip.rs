@@ -105,8 +105,8 @@ const UNLINKED: u32 = u32::MAX;
 /// opposite half-edge `twin[h]` (or [`NONE`] on the boundary), and one outgoing half-edge per
 /// vertex. Flat arrays instead of a hash map of directed edges: a third of the memory and no
 /// hashing in the flip loop.
-struct HalfEdges<'a> {
-    tri: &'a mut [[u32; 3]],
+pub(super) struct HalfEdges<'a> {
+    tri: &'a mut Vec<[u32; 3]>,
     twin: Vec<u32>,
     out: Vec<u32>,
 }
@@ -133,7 +133,7 @@ impl<'a> HalfEdges<'a> {
     /// Builds the structure, or `None` unless the triangles form a consistently oriented
     /// 2-manifold (each directed edge once, each vertex's triangles one fan): only there do
     /// the fan walks below see every triangle at a vertex.
-    fn new(tri: &'a mut [[u32; 3]], vertices: usize) -> Option<Self> {
+    pub(super) fn new(tri: &'a mut Vec<[u32; 3]>, vertices: usize) -> Option<Self> {
         let nh = 3 * tri.len();
         if nh >= NONE as usize {
             return None;
@@ -294,6 +294,209 @@ impl<'a> HalfEdges<'a> {
                 .is_some()
     }
 
+    /// Whether the edge of half-edge `h` (which has a twin) should be flipped: it is not
+    /// Delaunay on the surface or one of its triangles faces against the field
+    /// (`was_folded`), the flipped edge is new, both new triangles agree with the field, and
+    /// they do not fold over the old pair unless that undoes a fold. Returns `[a, b, c, d]`
+    /// for [`HalfEdges::flip`], `h = a → b`.
+    fn wants_flip(
+        &self,
+        points: &[[f64; 3]],
+        normals: &[[f64; 3]],
+        h: u32,
+        was_folded: bool,
+    ) -> Option<[u32; 4]> {
+        let g = self.twin[h as usize];
+        let (a, b) = (self.origin(h), self.dest(h));
+        let c = self.origin(prev(h));
+        let d = self.origin(prev(g));
+        let (pa, pb, pc, pd) = (
+            points[a as usize],
+            points[b as usize],
+            points[c as usize],
+            points[d as usize],
+        );
+        let old1 = [a, b, c];
+        let old2 = [b, a, d];
+        let new1 = [a, d, c];
+        let new2 = [d, b, c];
+        // The tests, cheapest and most often decisive first (almost every edge is already
+        // Delaunay and unfolded).
+        if !was_folded && !delaunay_violation(pa, pb, pc, pd) {
+            return None;
+        }
+        if c == d || self.adjacent(c, d) {
+            return None;
+        }
+        let new_ok = !against_field(points, normals, new1) && !against_field(points, normals, new2);
+        if !new_ok {
+            return None;
+        }
+        // The flipped pair must not fold over the old one (the quad must be convex enough)
+        // unless it undoes a fold.
+        let old_sum = {
+            let (f1, f2) = (face_normal(points, old1), face_normal(points, old2));
+            [f1[0] + f2[0], f1[1] + f2[1], f1[2] + f2[2]]
+        };
+        if (dot(face_normal(points, new1), old_sum) <= 0.0
+            || dot(face_normal(points, new2), old_sum) <= 0.0)
+            && !was_folded
+        {
+            return None;
+        }
+        Some([a, b, c, d])
+    }
+
+    /// The triangles, as flips and splits left them.
+    pub(super) fn triangles(&self) -> &[[u32; 3]] {
+        self.tri
+    }
+
+    /// The half-edge running the other way along `h`'s edge, `None` on the boundary.
+    pub(super) fn twin(&self, h: u32) -> Option<u32> {
+        let g = self.twin[h as usize];
+        (g != NONE).then_some(g)
+    }
+
+    /// The triangles around `v` into `faces`, and whether they close up around it (`v` is
+    /// interior).
+    pub(super) fn star(&self, v: u32, faces: &mut Vec<u32>) -> bool {
+        faces.clear();
+        let start = self.out[v as usize];
+        if start == NONE {
+            return false;
+        }
+        // Forwards (to the twin of the incoming half-edge), then, if the fan is open,
+        // backwards from `start`; the length check guards against a broken structure.
+        let mut h = start;
+        loop {
+            faces.push(h / 3);
+            let t = self.twin[prev(h) as usize];
+            if t == start {
+                return true;
+            }
+            if t == NONE || faces.len() > self.tri.len() {
+                break;
+            }
+            h = t;
+        }
+        let mut h = start;
+        loop {
+            let t = self.twin[h as usize];
+            if t == NONE || faces.len() > self.tri.len() {
+                return false;
+            }
+            h = next(t);
+            faces.push(h / 3);
+        }
+    }
+
+    /// Splits the edge of half-edge `h = a → b` at the new vertex `m` (the next vertex
+    /// index): its triangle `(a, b, c)` becomes `(a, m, c)` and `(m, b, c)`, and the triangle
+    /// `(b, a, d)` across it, if any, `(b, m, d)` and `(m, a, d)`. The new triangles are
+    /// appended. Returns the triangles rewritten or added.
+    pub(super) fn split(&mut self, h: u32, m: u32) -> Vec<u32> {
+        debug_assert_eq!(m as usize, self.out.len());
+        let g = self.twin[h as usize];
+        let t = h / 3;
+        let (a, b, c) = (self.origin(h), self.dest(h), self.origin(prev(h)));
+        let (bc, ca) = (self.twin[next(h) as usize], self.twin[prev(h) as usize]);
+        let (u, d, ad, db) = if g == NONE {
+            (NONE, NONE, NONE, NONE)
+        } else {
+            let d = self.origin(prev(g));
+            (
+                g / 3,
+                d,
+                self.twin[next(g) as usize],
+                self.twin[prev(g) as usize],
+            )
+        };
+        let t2 = self.tri.len() as u32;
+        self.tri[t as usize] = [a, m, c];
+        self.tri.push([m, b, c]);
+        self.twin.extend([NONE; 3]);
+        self.out.push(3 * t2);
+        self.link(3 * t + 1, 3 * t2 + 2);
+        self.link(3 * t + 2, ca);
+        self.link(3 * t2 + 1, bc);
+        self.out[a as usize] = 3 * t;
+        self.out[b as usize] = 3 * t2 + 1;
+        self.out[c as usize] = 3 * t + 2;
+        let mut changed = vec![t, t2];
+        if g == NONE {
+            self.twin[3 * t as usize] = NONE;
+            self.twin[3 * t2 as usize] = NONE;
+            return changed;
+        }
+        let u2 = self.tri.len() as u32;
+        self.tri[u as usize] = [b, m, d];
+        self.tri.push([m, a, d]);
+        self.twin.extend([NONE; 3]);
+        self.link(3 * t, 3 * u2);
+        self.link(3 * t2, 3 * u);
+        self.link(3 * u + 1, 3 * u2 + 2);
+        self.link(3 * u + 2, db);
+        self.link(3 * u2 + 1, ad);
+        self.out[d as usize] = 3 * u + 2;
+        changed.extend([u, u2]);
+        changed
+    }
+
+    /// Lawson flips from the edges of half-edges `seeds` outwards, with the criteria of
+    /// [`flip_to_surface_delaunay`], at most `budget` of them. `folded` flags the triangles
+    /// that face against the field (flips clear flags); the triangles rewritten are appended
+    /// to `changed`. Returns the number of flips.
+    pub(super) fn flip_from(
+        &mut self,
+        points: &[[f64; 3]],
+        normals: &[[f64; 3]],
+        seeds: &[u32],
+        folded: &mut [bool],
+        budget: usize,
+        changed: &mut Vec<u32>,
+    ) -> usize {
+        // The queue holds an edge as its two ends and the half-edge it had when queued,
+        // which a flip elsewhere may have moved.
+        let mut queue: VecDeque<(u32, u32, u32)> = (seeds.iter())
+            .map(|&h| (self.origin(h), self.dest(h), h))
+            .collect();
+        let max_visits = 20 * queue.len() + 20 * budget + 64;
+        let (mut flips, mut visits) = (0, 0);
+        while let Some((a, b, h)) = queue.pop_front() {
+            visits += 1;
+            if flips >= budget || visits > max_visits {
+                break;
+            }
+            let h = if self.origin(h) == a && self.dest(h) == b {
+                h
+            } else {
+                match self.find(a, b) {
+                    Some(h) => h,
+                    None => continue,
+                }
+            };
+            let g = self.twin[h as usize];
+            if g == NONE {
+                continue;
+            }
+            let (t1, t2) = (h / 3, g / 3);
+            let was_folded = folded[t1 as usize] || folded[t2 as usize];
+            let Some([a, b, c, d]) = self.wants_flip(points, normals, h, was_folded) else {
+                continue;
+            };
+            self.flip(t1, t2, [a, b, c, d]);
+            folded[t1 as usize] = false;
+            folded[t2 as usize] = false;
+            changed.extend([t1, t2]);
+            flips += 1;
+            // `t1 = (a, d, c)` and `t2 = (d, b, c)`: the quad's sides.
+            let (h1, h2) = (3 * t1, 3 * t2);
+            queue.extend([(a, d, h1), (d, b, h2), (b, c, h2 + 1), (c, a, h1 + 2)]);
+        }
+        flips
+    }
+
     /// The half-edge `x → y` of triangle `t` (which has it).
     fn slot(&self, t: u32, x: u32) -> u32 {
         let k = self.tri[t as usize]
@@ -363,7 +566,7 @@ pub(crate) struct FlipPass {
 pub(crate) fn flip_to_surface_delaunay(
     points: &[[f64; 3]],
     normals: &[[f64; 3]],
-    triangles: &mut [[u32; 3]],
+    triangles: &mut Vec<[u32; 3]>,
     budget: usize,
 ) -> FlipPass {
     let max_visits = 20 * triangles.len() + 1000;
@@ -432,43 +635,10 @@ pub(crate) fn flip_to_surface_delaunay(
             continue;
         }
         let (t1, t2) = (h / 3, g / 3);
-        let c = he.origin(prev(h));
-        let d = he.origin(prev(g));
-        let (pa, pb, pc, pd) = (
-            points[a as usize],
-            points[b as usize],
-            points[c as usize],
-            points[d as usize],
-        );
-        let old1 = [a, b, c];
-        let old2 = [b, a, d];
-        let new1 = [a, d, c];
-        let new2 = [d, b, c];
-        // The tests, cheapest and most often decisive first (almost every edge is already
-        // Delaunay and unfolded).
         let was_folded = folded.get(t1 as usize) || folded.get(t2 as usize);
-        if !was_folded && !delaunay_violation(pa, pb, pc, pd) {
+        let Some([a, b, c, d]) = he.wants_flip(points, normals, h, was_folded) else {
             continue;
-        }
-        if c == d || he.adjacent(c, d) {
-            continue;
-        }
-        let new_ok = !against_field(points, normals, new1) && !against_field(points, normals, new2);
-        if !new_ok {
-            continue;
-        }
-        // The flipped pair must not fold over the old one (the quad must be convex enough)
-        // unless it undoes a fold.
-        let old_sum = {
-            let (f1, f2) = (face_normal(points, old1), face_normal(points, old2));
-            [f1[0] + f2[0], f1[1] + f2[1], f1[2] + f2[2]]
         };
-        if (dot(face_normal(points, new1), old_sum) <= 0.0
-            || dot(face_normal(points, new2), old_sum) <= 0.0)
-            && !was_folded
-        {
-            continue;
-        }
         for t in [t1, t2] {
             if 3 * t as usize + 2 >= cursor {
                 unread.entry(t).or_insert(he.tri[t as usize]);
@@ -510,6 +680,76 @@ mod tests {
         }
         assert_eq!(he.find(4, 0), Some(2));
         assert!(he.adjacent(0, 2) && !he.adjacent(0, 1));
+    }
+
+    #[test]
+    fn splitting_an_edge_keeps_every_half_edge_paired_with_its_reverse() {
+        let (p, mut t) = octahedron();
+        let mut he = HalfEdges::new(&mut t, p.len()).expect("a closed 2-manifold");
+        let h = he.find(0, 2).unwrap();
+        let changed = he.split(h, 6);
+        assert_eq!(changed.len(), 4);
+        assert_eq!(he.triangles().len(), 10);
+        for h in 0..he.twin.len() as u32 {
+            let g = he.twin(h).expect("closed");
+            assert_eq!(he.twin[g as usize], h);
+            assert_eq!((he.origin(g), he.dest(g)), (he.dest(h), he.origin(h)));
+        }
+        for v in 0..7u32 {
+            assert_eq!(he.origin(he.out[v as usize]), v);
+        }
+        let mut star = Vec::new();
+        assert!(he.star(6, &mut star));
+        assert_eq!(star.len(), 4);
+        assert!(he.find(0, 2).is_none() && he.adjacent(0, 6) && he.adjacent(6, 2));
+        // The new vertex's neighbours are the edge's ends and the two opposite corners.
+        let mut ring: Vec<u32> = star
+            .iter()
+            .flat_map(|&f| he.triangles()[f as usize])
+            .filter(|&v| v != 6)
+            .collect();
+        ring.sort_unstable();
+        ring.dedup();
+        assert_eq!(ring, [0, 2, 4, 5]);
+        // An open fan: the split edge 1–2 is on the boundary.
+        let mut open = vec![[0u32, 1, 2], [0, 2, 3]];
+        let mut he = HalfEdges::new(&mut open, 4).unwrap();
+        assert!(!he.star(0, &mut star) && star.len() == 2);
+        let h = he.find(1, 2).unwrap();
+        assert_eq!(he.split(h, 4).len(), 2);
+        assert!(he.twin(0).is_none() && !he.star(4, &mut star) && star.len() == 2);
+    }
+
+    #[test]
+    fn flips_from_a_seed_undo_a_long_diagonal_and_only_there() {
+        // A flat rhombus split along its long diagonal 0–2 (angles of 147° at 1 and 3),
+        // beside a triangle on 2–3 that is fine as it is.
+        let p = vec![
+            [-1.0, 0.0, 0.0],
+            [0.0, -0.3, 0.0],
+            [1.0, 0.0, 0.0],
+            [0.0, 0.3, 0.0],
+            [1.0, 1.0, 0.0],
+        ];
+        let n = vec![[0.0, 0.0, 1.0]; 5];
+        let mut t = vec![[0, 1, 2], [0, 2, 3], [3, 2, 4]];
+        let mut he = HalfEdges::new(&mut t, 5).unwrap();
+        let mut folded = vec![false; 3];
+        let mut changed = Vec::new();
+        let fine = he.find(2, 3).unwrap();
+        assert_eq!(
+            he.flip_from(&p, &n, &[fine], &mut folded, 8, &mut changed),
+            0
+        );
+        assert!(changed.is_empty());
+        let long = he.find(0, 2).unwrap();
+        assert_eq!(
+            he.flip_from(&p, &n, &[long], &mut folded, 8, &mut changed),
+            1
+        );
+        changed.sort_unstable();
+        assert_eq!(changed, [0, 1]);
+        assert!(he.adjacent(1, 3) && he.find(0, 2).is_none() && he.find(2, 0).is_none());
     }
 
     #[test]

@@ -9,7 +9,10 @@ use serde::{Deserialize, Serialize};
 /// step 0). `s` is the arc length along the polyline of the curve measured from
 /// `p0` (inserted curves inherit the arc length of the point they start from),
 /// and `theta` is the curve's angle at `p0` in the chart, in radians.
-/// Vertices added to close a surface carry `curve == u32::MAX`.
+/// Vertices added to close a surface carry `curve == u32::MAX`
+/// ([`Provenance::CLOSING_CURVE`]); vertices added by refinement carry
+/// [`Provenance::REFINED_CURVE`], the round that added them as `step`, and the arc length and
+/// angle of the vertex their chord started from.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct Provenance {
     /// Index of the integral curve the vertex lies on.
@@ -25,6 +28,8 @@ pub struct Provenance {
 impl Provenance {
     /// Curve id given to vertices that were added to close a surface.
     pub const CLOSING_CURVE: u32 = u32::MAX;
+    /// Curve id given to vertices that refinement to a normal-error bound added.
+    pub const REFINED_CURVE: u32 = u32::MAX - 1;
 }
 
 /// A triangle mesh in `f64`: vertices, unit field normals at the vertices,

@@ -15,9 +15,12 @@
 
 mod flip;
 mod mesh;
+mod refine;
 mod relax;
 mod reopen;
 
+pub(crate) use refine::refine;
+pub use refine::{Refinement, MAX_REFINE_ROUNDS};
 pub(crate) use relax::relax;
 
 #[cfg(test)]

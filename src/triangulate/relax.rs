@@ -19,7 +19,7 @@ use crate::NormalField;
 /// on the presets and the ellipsoid while moving vertices by a fraction of a step.
 const SWEEPS: usize = 3;
 /// Fraction of the way to the neighbours' centroid moved per sweep.
-const DAMPING: f64 = 0.5;
+pub(super) const DAMPING: f64 = 0.5;
 
 /// Relaxes `mesh` (whose vertices are `samples` points, found by provenance) and returns the
 /// vertices in the working precision.
@@ -90,21 +90,10 @@ pub(crate) fn relax<T: Scalar, F: NormalField<T>>(
     let mut agreement: Option<Vec<f64>> = None;
     for _ in 0..SWEEPS {
         let moved: Vec<Vec3<T>> = par::map(n, par::MIN_COSTLY, |v| {
-            let nb = neighbours(v);
-            if fixed[v] || nb.is_empty() {
+            if fixed[v] {
                 return pos[v].clone();
             }
-            let mut c = Vec3::<T>::zero();
-            for &u in nb {
-                c = &c + &pos[u as usize];
-            }
-            let c = c.scale(&(T::one() / T::from_f64(nb.len() as f64)));
-            let d = &c - &pos[v];
-            let len = d.norm() * damping.clone();
-            if len.partial_cmp(&T::zero()) != Some(std::cmp::Ordering::Greater) {
-                return pos[v].clone();
-            }
-            trace::step_fixed(field, &cfg, &pos[v], &d, &len).unwrap_or_else(|_| pos[v].clone())
+            towards_centroid(field, &cfg, &pos, v, neighbours(v), &damping)
         });
         let kept = keep_orientation(&mesh.triangles, &mesh.normals, pos, moved, agreement);
         (pos, agreement) = (kept.0, Some(kept.1));
@@ -125,8 +114,34 @@ pub(crate) fn relax<T: Scalar, F: NormalField<T>>(
     pos
 }
 
+/// Where vertex `v` moves: `damping` of the way to the centroid of its `neighbours`, along
+/// the surface (a chord of [`trace::step_fixed`]); where it is unless that chord exists.
+pub(super) fn towards_centroid<T: Scalar, F: NormalField<T>>(
+    field: &F,
+    cfg: &StepConfig<T>,
+    pos: &[Vec3<T>],
+    v: usize,
+    neighbours: &[u32],
+    damping: &T,
+) -> Vec3<T> {
+    if neighbours.is_empty() {
+        return pos[v].clone();
+    }
+    let mut c = Vec3::<T>::zero();
+    for &u in neighbours {
+        c = &c + &pos[u as usize];
+    }
+    let c = c.scale(&(T::one() / T::from_f64(neighbours.len() as f64)));
+    let d = &c - &pos[v];
+    let len = d.norm() * damping.clone();
+    if len.partial_cmp(&T::zero()) != Some(std::cmp::Ordering::Greater) {
+        return pos[v].clone();
+    }
+    trace::step_fixed(field, cfg, &pos[v], &d, &len).unwrap_or_else(|_| pos[v].clone())
+}
+
 /// Cosine between a face and the field normal below which a move counts as folding it.
-const MIN_AGREEMENT: f64 = 0.5;
+pub(super) const MIN_AGREEMENT: f64 = 0.5;
 
 /// Accepts the sweep's moves except where a triangle would fold: the vertices of every
 /// triangle whose face normal turns away from the field normal (and did not before) go back
