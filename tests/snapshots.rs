@@ -62,16 +62,25 @@ fn snapshot_text(run: &MeshRun<f64>) -> String {
     out
 }
 
-fn assert_preset_snapshot(preset: Preset) {
-    let text = snapshot_text(&run(preset, &preset.params()));
+/// Checks `run` against the snapshot `name`, made by the command `command`.
+fn assert_run_snapshot(name: &str, command: &str, run: &MeshRun<f64>) {
+    let text = snapshot_text(run);
     insta::with_settings!({
         snapshot_path => "../snapshots",
         prepend_module_to_snapshot => false,
-        description => format!("liemesh mesh --preset {preset}: counts, canonical triangles, vertices rounded to 1e-9"),
+        description => format!("{command}: counts, canonical triangles, vertices rounded to 1e-9"),
         omit_expression => true,
     }, {
-        insta::assert_snapshot!(preset.name(), text);
+        insta::assert_snapshot!(name, text);
     });
+}
+
+fn assert_preset_snapshot(preset: Preset) {
+    assert_run_snapshot(
+        preset.name(),
+        &format!("liemesh mesh --preset {preset}"),
+        &run(preset, &preset.params()),
+    );
 }
 
 #[test]
@@ -102,6 +111,23 @@ fn fig5_triangulation_matches_its_snapshot() {
 #[test]
 fn fig6_triangulation_matches_its_snapshot() {
     assert_preset_snapshot(Preset::Fig6);
+}
+
+/// Refinement to a normal-error bound adds vertices by chords and flips: its output is as
+/// deterministic as the rest.
+#[test]
+fn fig3_refined_to_one_degree_matches_its_snapshot() {
+    let mut params = Preset::Fig3.params();
+    params.max_normal_error = Some(1f64.to_radians());
+    let refined = run(Preset::Fig3, &params);
+    assert!(refined
+        .refinement
+        .is_some_and(|r| r.added > 0 && r.over_limit == 0));
+    assert_run_snapshot(
+        "fig3-refined",
+        "liemesh mesh --preset fig3 --max-normal-error 1",
+        &refined,
+    );
 }
 
 /// The snapshots can fail: changing a preset's parameters changes its triangulation and so
