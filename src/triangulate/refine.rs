@@ -90,7 +90,6 @@ pub(crate) fn refine<T: Scalar, F: NormalField<T>>(
     let mut folded: Vec<bool> = (he.triangles().iter())
         .map(|&t| against_field(vertices, normals, t))
         .collect();
-    let half = T::from_f64(0.5);
     let mut star = Vec::new();
     let mut marks = Marks::default();
     for round in 0..MAX_REFINE_ROUNDS {
@@ -120,33 +119,12 @@ pub(crate) fn refine<T: Scalar, F: NormalField<T>>(
             let Some(h) = propagation_end(&he, vertices, t) else {
                 continue;
             };
-            let tri = he.triangles()[(h / 3) as usize];
-            let k = (h % 3) as usize;
-            let [a, b, c] = [tri[k], tri[(k + 1) % 3], tri[(k + 2) % 3]];
-            let d = he
-                .twin(h)
-                .map(|g| he.triangles()[(g / 3) as usize][((g + 2) % 3) as usize]);
-            let dir = &pos[b as usize] - &pos[a as usize];
-            let length = dir.norm() * half.clone();
-            let Ok(p) = trace::step_fixed(field, &cfg, &pos[a as usize], &dir, &length) else {
+            let a = he.triangles()[(h / 3) as usize][(h % 3) as usize];
+            let Some((m, rewritten)) = split_edge(field, &cfg, &mut he, vertices, normals, pos, h)
+            else {
                 continue;
             };
-            let Ok((_, n, _)) = trace::unit_normal(field, &p) else {
-                continue;
-            };
-            let m = vertices.len() as u32;
-            vertices.push(p.to_f64());
-            normals.push(n.to_f64());
-            let mut faces = vec![[a, m, c], [m, b, c]];
-            if let Some(d) = d {
-                faces.extend([[b, m, d], [m, a, d]]);
-            }
-            if faces.iter().any(|&f| against_field(vertices, normals, f)) {
-                vertices.pop();
-                normals.pop();
-                continue;
-            }
-            for t in he.split(h, m) {
+            for t in rewritten {
                 if t as usize >= folded.len() {
                     folded.resize(t as usize + 1, false);
                 }
@@ -162,7 +140,6 @@ pub(crate) fn refine<T: Scalar, F: NormalField<T>>(
                 step: round as u32 + 1,
                 ..provenance[a as usize]
             });
-            pos.push(p);
             added.push(m);
         }
         if added.is_empty() {
@@ -199,6 +176,43 @@ pub(crate) fn refine<T: Scalar, F: NormalField<T>>(
         done.over_limit = errors.iter().filter(|&&e| e > limit_deg).count();
     }
     done
+}
+
+/// Splits the edge of half-edge `h = a → b` at a new vertex on the surface: a chord from `a`
+/// towards `b`, half the edge long. Returns the new vertex and the triangles rewritten or
+/// added, or `None` (and changes nothing) where the chord has no root or a new triangle would
+/// face against the field.
+fn split_edge<T: Scalar, F: NormalField<T>>(
+    field: &F,
+    cfg: &StepConfig<T>,
+    he: &mut HalfEdges,
+    vertices: &mut Vec<[f64; 3]>,
+    normals: &mut Vec<[f64; 3]>,
+    pos: &mut Vec<Vec3<T>>,
+    h: u32,
+) -> Option<(u32, Vec<u32>)> {
+    let tri = he.triangles()[(h / 3) as usize];
+    let k = (h % 3) as usize;
+    let [a, b, c] = [tri[k], tri[(k + 1) % 3], tri[(k + 2) % 3]];
+    let d = (he.twin(h)).map(|g| he.triangles()[(g / 3) as usize][((g + 2) % 3) as usize]);
+    let dir = &pos[b as usize] - &pos[a as usize];
+    let length = dir.norm() * T::from_f64(0.5);
+    let p = trace::step_fixed(field, cfg, &pos[a as usize], &dir, &length).ok()?;
+    let (_, n, _) = trace::unit_normal(field, &p).ok()?;
+    let m = vertices.len() as u32;
+    vertices.push(p.to_f64());
+    normals.push(n.to_f64());
+    let mut faces = vec![[a, m, c], [m, b, c]];
+    if let Some(d) = d {
+        faces.extend([[b, m, d], [m, a, d]]);
+    }
+    if faces.iter().any(|&f| against_field(vertices, normals, f)) {
+        vertices.pop();
+        normals.pop();
+        return None;
+    }
+    pos.push(p);
+    Some((m, he.split(h, m)))
 }
 
 /// The edges of the triangles in `list`, each once, as half-edges.
@@ -441,6 +455,56 @@ mod tests {
             .filter(|p| p.curve == Provenance::REFINED_CURVE)
             .count();
         assert_eq!(refined, done.added);
+    }
+
+    #[test]
+    fn an_open_cap_is_refined_up_to_its_rim_which_stays_in_place() {
+        let field = LieField::<f64>::new(&sphere());
+        let mut params = coarse_sphere(1.0);
+        params.terminal.close = false;
+        params.terminal.max_radius = 1.2;
+        let unrefined = crate::run(
+            &field,
+            &MeshParams {
+                max_normal_error: None,
+                ..params.clone()
+            },
+        )
+        .unwrap();
+        let run = crate::run(&field, &params).unwrap();
+        let done = run.refinement.unwrap();
+        assert!(done.added > 10 && done.over_limit == 0, "{done:?}");
+        crate::fuzz_checks::check_mesh(&run.mesh).unwrap();
+        let (before, after) = (Topology::of(&unrefined.mesh), Topology::of(&run.mesh));
+        assert!(
+            before.boundary_loops == 1 && after.boundary_loops == 1,
+            "{after:?}"
+        );
+        // Rim vertices are not smoothed (the rim may gain vertices, on the sphere).
+        let rim = |m: &Mesh| {
+            let mut uses = std::collections::HashMap::new();
+            for t in &m.triangles {
+                for k in 0..3 {
+                    let (a, b) = (t[k], t[(k + 1) % 3]);
+                    *uses.entry((a.min(b), a.max(b))).or_insert(0) += 1;
+                }
+            }
+            let mut v: Vec<u32> = (uses.into_iter())
+                .filter(|&(_, n)| n == 1)
+                .flat_map(|((a, b), _)| [a, b])
+                .collect();
+            v.sort_unstable();
+            v.dedup();
+            v
+        };
+        let old_rim = rim(&unrefined.mesh);
+        for &v in &old_rim {
+            assert_eq!(
+                run.mesh.vertices[v as usize],
+                unrefined.mesh.vertices[v as usize]
+            );
+        }
+        assert!(rim(&run.mesh).len() >= old_rim.len());
     }
 
     #[test]
