@@ -2,7 +2,9 @@
 //! ellipsoid at about 10^4, 10^5 and 10^6 triangles: sampling, the chart triangulation with
 //! its closing and first flip pass, and the whole pipeline (the difference is the
 //! relaxation, its flip pass and the assembly of the working-precision vertices),
-//! (c) fig6 sampling per scalar type, (d) spade's bulk load of the same chart points.
+//! (c) fig6 sampling per scalar type, (d) spade's bulk load of the same chart points, and
+//! (e) the fidelity workload: the coarsest sphere and ellipsoid meshes within 0.7° of the
+//! field normals, refinement included, as `liemesh bench`'s scan finds them.
 
 use criterion::{
     criterion_group, criterion_main, BenchmarkId, Criterion, SamplingMode, Throughput,
@@ -148,5 +150,20 @@ fn scalars(c: &mut Criterion) {
     g.finish();
 }
 
-criterion_group!(benches, presets, sizes, scalars);
+fn fidelity(c: &mut Criterion) {
+    let mut g = configure(c, "fidelity");
+    for (ellipsoid, label) in [(false, "sphere"), (true, "ellipsoid")] {
+        let found =
+            liemesh::cli::fidelity_scan(ellipsoid, liemesh::cli::FIDELITY_MAX_TRIANGLES).unwrap();
+        assert!(found.reached, "{label}: {found:?}");
+        let field = LieField::<f64>::new(&found.invariant);
+        g.throughput(Throughput::Elements(found.triangles as u64));
+        g.bench_function(label, |b| {
+            b.iter(|| liemesh::generate(black_box(&field), &found.params).unwrap())
+        });
+    }
+    g.finish();
+}
+
+criterion_group!(benches, presets, sizes, scalars, fidelity);
 criterion_main!(benches);

@@ -352,19 +352,32 @@ fn time_workload(
     })
 }
 
+/// What the fidelity scan found: the parameters of its mesh and what that mesh is like.
+#[derive(Debug, Clone)]
+pub struct FidelityScan {
+    /// The invariant (sphere or ellipsoid).
+    pub invariant: Invariant,
+    /// The parameters of the mesh found, refinement to [`FIDELITY_LIMIT_DEG`] included.
+    pub params: MeshParams,
+    /// Triangles of that mesh.
+    pub triangles: usize,
+    /// Vertices the refinement added to it.
+    pub refined: usize,
+    /// Its largest face-normal error, degrees.
+    pub max_error_deg: f64,
+    /// Whether it is within the limit (otherwise it is the trial with the lowest error).
+    pub reached: bool,
+}
+
 /// Scans the β band of [`workload_params`] downward (each trial 15 % narrower), at its own
 /// insertion gap and at [`FIDELITY_CLOSER_GAP`], refining each mesh to [`FIDELITY_LIMIT_DEG`],
-/// then times the mesh with the fewest triangles that got there. A scan at one gap stops
-/// once its mesh before refinement has more triangles than the best so far (narrower bands
-/// only add more), or beyond `max_triangles`. If none got there (the rounds or the point
-/// budget ran out), the row holds the lowest error seen and `reached == false`.
-fn fidelity(
-    ellipsoid: bool,
-    max_triangles: usize,
-    repeats: usize,
-) -> Result<FidelityRow, CliError> {
-    let (inv, base) = workload_params(ellipsoid, if ellipsoid { 9000 } else { 2000 });
-    let field = LieField::<f64>::new(&inv);
+/// and keeps the mesh with the fewest triangles that got there. A scan at one gap stops once
+/// its mesh before refinement has more triangles than the best so far (narrower bands only
+/// add more), or beyond `max_triangles`. If none got there (the rounds or the point budget ran
+/// out), it keeps the trial with the lowest error, `reached == false`.
+pub fn fidelity_scan(ellipsoid: bool, max_triangles: usize) -> Result<FidelityScan, CliError> {
+    let (invariant, base) = workload_params(ellipsoid, if ellipsoid { 9000 } else { 2000 });
+    let field = LieField::<f64>::new(&invariant);
     let trial = |[gap, merge]: [f64; 2], scale: f64| {
         let mut params = base.clone();
         params.gap = gap;
@@ -375,40 +388,33 @@ fn fidelity(
         params.max_normal_error = Some(FIDELITY_LIMIT_DEG.to_radians());
         params
     };
-    struct Seen {
-        error: f64,
-        triangles: usize,
-        refined: usize,
-        gap: [f64; 2],
-        scale: f64,
-    }
     // The coarsest within the limit, else the lowest error.
-    let mut reached: Option<Seen> = None;
-    let mut lowest: Option<Seen> = None;
+    let mut reached: Option<FidelityScan> = None;
+    let mut lowest: Option<FidelityScan> = None;
     for gap in [[base.gap, base.merge], FIDELITY_CLOSER_GAP] {
         // Start 4× coarser than the fig3 band.
         let mut scale = 4.0;
         while scale > 1e-3 {
-            let run = crate::run(&field, &trial(gap, scale))?;
+            let params = trial(gap, scale);
+            let run = crate::run(&field, &params)?;
             let (error, _) = crate::quality::face_normal_error(&field, &run.mesh);
             let refined = run.refinement.map_or(0, |r| r.added);
             let triangles = run.mesh.triangles.len();
             // Each added vertex split two triangles in two.
             let unrefined = triangles.saturating_sub(2 * refined);
-            let seen = || Seen {
-                error,
+            let within = error <= FIDELITY_LIMIT_DEG && triangles <= max_triangles;
+            let seen = || FidelityScan {
+                invariant: invariant.clone(),
+                params: params.clone(),
                 triangles,
                 refined,
-                gap,
-                scale,
+                max_error_deg: error,
+                reached: within,
             };
-            if lowest.as_ref().is_none_or(|l| error < l.error) {
+            if lowest.as_ref().is_none_or(|l| error < l.max_error_deg) {
                 lowest = Some(seen());
             }
-            if error <= FIDELITY_LIMIT_DEG
-                && triangles <= max_triangles
-                && reached.as_ref().is_none_or(|r| triangles < r.triangles)
-            {
+            if within && reached.as_ref().is_none_or(|r| triangles < r.triangles) {
                 reached = Some(seen());
             }
             if triangles > max_triangles
@@ -419,23 +425,32 @@ fn fidelity(
             scale *= 0.85;
         }
     }
-    let is_reached = reached.is_some();
-    let best = reached.or(lowest).expect("at least one trial");
-    let params = trial(best.gap, best.scale);
+    Ok(reached.or(lowest).expect("at least one trial"))
+}
+
+/// [`fidelity_scan`], then times its mesh end to end `repeats` times.
+fn fidelity(
+    ellipsoid: bool,
+    max_triangles: usize,
+    repeats: usize,
+) -> Result<FidelityRow, CliError> {
+    let found = fidelity_scan(ellipsoid, max_triangles)?;
+    let field = LieField::<f64>::new(&found.invariant);
+    let params = &found.params;
     let mut times = Vec::new();
     for _ in 0..repeats {
         let t0 = Instant::now();
-        std::hint::black_box(crate::generate(&field, &params)?);
+        std::hint::black_box(crate::generate(&field, params)?);
         times.push(t0.elapsed().as_secs_f64() * 1e3);
     }
     Ok(FidelityRow {
         workload: if ellipsoid { "ellipsoid" } else { "sphere" }.to_string(),
         beta_deg: [params.beta_min.to_degrees(), params.beta_max.to_degrees()],
-        gap: best.gap,
-        triangles: best.triangles,
-        refined: best.refined,
-        max_error_deg: best.error,
-        reached: is_reached,
+        gap: [params.gap, params.merge],
+        triangles: found.triangles,
+        refined: found.refined,
+        max_error_deg: found.max_error_deg,
+        reached: found.reached,
         ms: median(times),
     })
 }
