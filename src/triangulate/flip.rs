@@ -22,6 +22,7 @@ fn angle_at(c: [f64; 3], a: [f64; 3], b: [f64; 3]) -> f64 {
 /// Whether the angles at `c` in (a, b, c) and at `d` in (b, a, d) add up to more than π,
 /// i.e. the edge `ab` is not Delaunay on the surface. Two acute angles cannot, which settles
 /// most edges without an arctangent.
+#[inline(always)]
 fn delaunay_violation(pa: [f64; 3], pb: [f64; 3], pc: [f64; 3], pd: [f64; 3]) -> bool {
     if dot(sub(pa, pc), sub(pb, pc)) > 0.0 && dot(sub(pb, pd), sub(pa, pd)) > 0.0 {
         return false;
@@ -105,8 +106,8 @@ const UNLINKED: u32 = u32::MAX;
 /// opposite half-edge `twin[h]` (or [`NONE`] on the boundary), and one outgoing half-edge per
 /// vertex. Flat arrays instead of a hash map of directed edges: a third of the memory and no
 /// hashing in the flip loop.
-pub(super) struct HalfEdges<'a> {
-    tri: &'a mut Vec<[u32; 3]>,
+pub(super) struct HalfEdges {
+    tri: Vec<[u32; 3]>,
     twin: Vec<u32>,
     out: Vec<u32>,
 }
@@ -129,11 +130,26 @@ fn prev(h: u32) -> u32 {
     }
 }
 
-impl<'a> HalfEdges<'a> {
-    /// Builds the structure, or `None` unless the triangles form a consistently oriented
-    /// 2-manifold (each directed edge once, each vertex's triangles one fan): only there do
-    /// the fan walks below see every triangle at a vertex.
-    pub(super) fn new(tri: &'a mut Vec<[u32; 3]>, vertices: usize) -> Option<Self> {
+impl HalfEdges {
+    /// Builds the structure on the triangles `tri`, or gives them back unless they form a
+    /// consistently oriented 2-manifold (each directed edge once, each vertex's triangles one
+    /// fan): only there do the fan walks below see every triangle at a vertex.
+    #[inline]
+    pub(super) fn new(tri: Vec<[u32; 3]>, vertices: usize) -> Result<Self, Vec<[u32; 3]>> {
+        match Self::links(&tri, vertices) {
+            Some((twin, out)) => Ok(HalfEdges { tri, twin, out }),
+            None => Err(tri),
+        }
+    }
+
+    /// The triangles, given back.
+    pub(super) fn into_triangles(self) -> Vec<[u32; 3]> {
+        self.tri
+    }
+
+    /// `twin` and `out` of [`HalfEdges::new`], or `None`.
+    #[inline(always)]
+    fn links(tri: &[[u32; 3]], vertices: usize) -> Option<(Vec<u32>, Vec<u32>)> {
         let nh = 3 * tri.len();
         if nh >= NONE as usize {
             return None;
@@ -228,7 +244,7 @@ impl<'a> HalfEdges<'a> {
                 return None;
             }
         }
-        Some(HalfEdges { tri, twin, out })
+        Some((twin, out))
     }
 
     #[inline]
@@ -294,22 +310,18 @@ impl<'a> HalfEdges<'a> {
                 .is_some()
     }
 
-    /// Whether the edge of half-edge `h` (which has a twin) should be flipped: it is not
-    /// Delaunay on the surface or one of its triangles faces against the field
-    /// (`was_folded`), the flipped edge is new, both new triangles agree with the field, and
-    /// they do not fold over the old pair unless that undoes a fold. Returns `[a, b, c, d]`
-    /// for [`HalfEdges::flip`], `h = a → b`.
+    /// Whether the edge `ab` between the triangles `(a, b, c)` and `(b, a, d)` should be
+    /// flipped to `cd`: it is not Delaunay on the surface or one of its triangles faces against
+    /// the field (`was_folded`), the edge `cd` is new, both new triangles agree with the field,
+    /// and they do not fold over the old pair unless that undoes a fold.
+    #[inline(always)]
     fn wants_flip(
         &self,
         points: &[[f64; 3]],
         normals: &[[f64; 3]],
-        h: u32,
+        [a, b, c, d]: [u32; 4],
         was_folded: bool,
-    ) -> Option<[u32; 4]> {
-        let g = self.twin[h as usize];
-        let (a, b) = (self.origin(h), self.dest(h));
-        let c = self.origin(prev(h));
-        let d = self.origin(prev(g));
+    ) -> bool {
         let (pa, pb, pc, pd) = (
             points[a as usize],
             points[b as usize],
@@ -323,14 +335,14 @@ impl<'a> HalfEdges<'a> {
         // The tests, cheapest and most often decisive first (almost every edge is already
         // Delaunay and unfolded).
         if !was_folded && !delaunay_violation(pa, pb, pc, pd) {
-            return None;
+            return false;
         }
         if c == d || self.adjacent(c, d) {
-            return None;
+            return false;
         }
         let new_ok = !against_field(points, normals, new1) && !against_field(points, normals, new2);
         if !new_ok {
-            return None;
+            return false;
         }
         // The flipped pair must not fold over the old one (the quad must be convex enough)
         // unless it undoes a fold.
@@ -342,14 +354,14 @@ impl<'a> HalfEdges<'a> {
             || dot(face_normal(points, new2), old_sum) <= 0.0)
             && !was_folded
         {
-            return None;
+            return false;
         }
-        Some([a, b, c, d])
+        true
     }
 
     /// The triangles, as flips and splits left them.
     pub(super) fn triangles(&self) -> &[[u32; 3]] {
-        self.tri
+        &self.tri
     }
 
     /// The half-edge running the other way along `h`'s edge, `None` on the boundary.
@@ -481,10 +493,11 @@ impl<'a> HalfEdges<'a> {
                 continue;
             }
             let (t1, t2) = (h / 3, g / 3);
+            let (c, d) = (self.origin(prev(h)), self.origin(prev(g)));
             let was_folded = folded[t1 as usize] || folded[t2 as usize];
-            let Some([a, b, c, d]) = self.wants_flip(points, normals, h, was_folded) else {
+            if !self.wants_flip(points, normals, [a, b, c, d], was_folded) {
                 continue;
-            };
+            }
             self.flip(t1, t2, [a, b, c, d]);
             folded[t1 as usize] = false;
             folded[t2 as usize] = false;
@@ -570,11 +583,15 @@ pub(crate) fn flip_to_surface_delaunay(
     budget: usize,
 ) -> FlipPass {
     let max_visits = 20 * triangles.len() + 1000;
-    let Some(mut he) = HalfEdges::new(triangles, points.len()) else {
-        return FlipPass {
-            flips: 0,
-            folded: None,
-        };
+    let mut he = match HalfEdges::new(std::mem::take(triangles), points.len()) {
+        Ok(he) => he,
+        Err(tri) => {
+            *triangles = tri;
+            return FlipPass {
+                flips: 0,
+                folded: None,
+            };
+        }
     };
     // The queue: every edge once, in triangle order, then the edges around each flip in
     // the order of the flips. The first part is not stored but read from the triangles'
@@ -586,7 +603,7 @@ pub(crate) fn flip_to_surface_delaunay(
     let mut queue: VecDeque<(u32, u32)> = VecDeque::new();
     // Which triangles face against the field, computed once: a flip only ever creates
     // triangles that agree with it, so the flags change only by being cleared.
-    let tri = &*he.tri;
+    let tri = &he.tri;
     let mut folded = FlagSet(par::map(tri.len().div_ceil(64), par::MIN_CHEAP / 64, |w| {
         let chunk = &tri[64 * w..(64 * w + 64).min(tri.len())];
         chunk.iter().enumerate().fold(0u64, |bits, (k, t)| {
@@ -635,10 +652,11 @@ pub(crate) fn flip_to_surface_delaunay(
             continue;
         }
         let (t1, t2) = (h / 3, g / 3);
+        let (c, d) = (he.origin(prev(h)), he.origin(prev(g)));
         let was_folded = folded.get(t1 as usize) || folded.get(t2 as usize);
-        let Some([a, b, c, d]) = he.wants_flip(points, normals, h, was_folded) else {
+        if !he.wants_flip(points, normals, [a, b, c, d], was_folded) {
             continue;
-        };
+        }
         for t in [t1, t2] {
             if 3 * t as usize + 2 >= cursor {
                 unread.entry(t).or_insert(he.tri[t as usize]);
@@ -652,6 +670,7 @@ pub(crate) fn flip_to_surface_delaunay(
             queue.push_back((x.min(y), x.max(y)));
         }
     }
+    *triangles = he.into_triangles();
     // Flips only clear flags (both new triangles must agree with the field), so the flags
     // left are exactly the triangles that still face against it.
     FlipPass {
@@ -667,8 +686,8 @@ mod tests {
 
     #[test]
     fn half_edges_of_a_closed_surface_pair_every_edge_with_its_reverse() {
-        let (p, mut t) = octahedron();
-        let he = HalfEdges::new(&mut t, p.len()).expect("a closed 2-manifold");
+        let (p, t) = octahedron();
+        let he = HalfEdges::new(t, p.len()).expect("a closed 2-manifold");
         for h in 0..he.twin.len() as u32 {
             let g = he.twin[h as usize];
             assert_ne!(g, NONE);
@@ -684,8 +703,8 @@ mod tests {
 
     #[test]
     fn splitting_an_edge_keeps_every_half_edge_paired_with_its_reverse() {
-        let (p, mut t) = octahedron();
-        let mut he = HalfEdges::new(&mut t, p.len()).expect("a closed 2-manifold");
+        let (p, t) = octahedron();
+        let mut he = HalfEdges::new(t, p.len()).expect("a closed 2-manifold");
         let h = he.find(0, 2).unwrap();
         let changed = he.split(h, 6);
         assert_eq!(changed.len(), 4);
@@ -712,8 +731,8 @@ mod tests {
         ring.dedup();
         assert_eq!(ring, [0, 2, 4, 5]);
         // An open fan: the split edge 1–2 is on the boundary.
-        let mut open = vec![[0u32, 1, 2], [0, 2, 3]];
-        let mut he = HalfEdges::new(&mut open, 4).unwrap();
+        let open = vec![[0u32, 1, 2], [0, 2, 3]];
+        let mut he = HalfEdges::new(open, 4).unwrap();
         assert!(!he.star(0, &mut star) && star.len() == 2);
         let h = he.find(1, 2).unwrap();
         assert_eq!(he.split(h, 4).len(), 2);
@@ -732,8 +751,8 @@ mod tests {
             [1.0, 1.0, 0.0],
         ];
         let n = vec![[0.0, 0.0, 1.0]; 5];
-        let mut t = vec![[0, 1, 2], [0, 2, 3], [3, 2, 4]];
-        let mut he = HalfEdges::new(&mut t, 5).unwrap();
+        let t = vec![[0, 1, 2], [0, 2, 3], [3, 2, 4]];
+        let mut he = HalfEdges::new(t, 5).unwrap();
         let mut folded = vec![false; 3];
         let mut changed = Vec::new();
         let fine = he.find(2, 3).unwrap();
@@ -754,8 +773,8 @@ mod tests {
 
     #[test]
     fn half_edges_leave_the_boundary_of_an_open_fan_unpaired() {
-        let mut t = vec![[0, 1, 2], [0, 2, 3]];
-        let he = HalfEdges::new(&mut t, 4).expect("an open fan");
+        let t = vec![[0, 1, 2], [0, 2, 3]];
+        let he = HalfEdges::new(t, 4).expect("an open fan");
         let unpaired = he.twin.iter().filter(|&&g| g == NONE).count();
         assert_eq!(unpaired, 4);
         assert_eq!(he.twin[2], 3);
@@ -768,21 +787,21 @@ mod tests {
     #[test]
     fn half_edges_refuse_a_vertex_whose_triangles_form_two_fans() {
         // Two triangles touching only at vertex 0 (a bow tie).
-        let mut t = vec![[0, 1, 2], [0, 3, 4]];
-        assert!(HalfEdges::new(&mut t, 5).is_none());
+        let t = vec![[0, 1, 2], [0, 3, 4]];
+        assert!(HalfEdges::new(t, 5).is_err());
     }
 
     #[test]
     fn half_edges_refuse_a_directed_edge_used_twice() {
         // Both triangles run 0 → 1: one of them is upside down.
-        let mut t = vec![[0, 1, 2], [0, 1, 3]];
-        assert!(HalfEdges::new(&mut t, 4).is_none());
+        let t = vec![[0, 1, 2], [0, 1, 3]];
+        assert!(HalfEdges::new(t, 4).is_err());
     }
 
     #[test]
     fn half_edges_refuse_a_triangle_with_a_repeated_corner() {
-        let mut t = vec![[0, 1, 1], [0, 1, 2]];
-        assert!(HalfEdges::new(&mut t, 3).is_none());
+        let t = vec![[0, 1, 1], [0, 1, 2]];
+        assert!(HalfEdges::new(t, 3).is_err());
     }
 
     #[test]

@@ -82,8 +82,12 @@ pub(crate) fn refine<T: Scalar, F: NormalField<T>>(
         triangles,
         provenance,
     } = mesh;
-    let Some(mut he) = HalfEdges::new(triangles, vertices.len()) else {
-        return done;
+    let mut he = match HalfEdges::new(std::mem::take(triangles), vertices.len()) {
+        Ok(he) => he,
+        Err(tri) => {
+            *triangles = tri;
+            return done;
+        }
     };
     // Faces against the field, which only flips may let go of: splits and smoothing make
     // none (both are checked), so the flags only ever clear.
@@ -175,6 +179,7 @@ pub(crate) fn refine<T: Scalar, F: NormalField<T>>(
         }
         done.over_limit = errors.iter().filter(|&&e| e > limit_deg).count();
     }
+    *triangles = he.into_triangles();
     done
 }
 
@@ -571,8 +576,8 @@ mod tests {
             [0.2, -3.0, 0.0],
             [3.0, -1.0, 0.0],
         ];
-        let mut tris = vec![[0, 1, 2], [1, 0, 3], [1, 3, 4]];
-        let he = HalfEdges::new(&mut tris, vertices.len()).unwrap();
+        let tris = vec![[0, 1, 2], [1, 0, 3], [1, 3, 4]];
+        let he = HalfEdges::new(tris, vertices.len()).unwrap();
         let h = propagation_end(&he, &vertices, 0).unwrap();
         let t = he.triangles()[(h / 3) as usize];
         let k = (h % 3) as usize;

@@ -116,6 +116,7 @@ pub(crate) fn relax<T: Scalar, F: NormalField<T>>(
 
 /// Where vertex `v` moves: `damping` of the way to the centroid of its `neighbours`, along
 /// the surface (a chord of [`trace::step_fixed`]); where it is unless that chord exists.
+#[inline]
 pub(super) fn towards_centroid<T: Scalar, F: NormalField<T>>(
     field: &F,
     cfg: &StepConfig<T>,
