@@ -9,35 +9,14 @@
 use criterion::{
     criterion_group, criterion_main, BenchmarkId, Criterion, SamplingMode, Throughput,
 };
-use liemesh::model::{Invariant, LieField};
+// The workloads of `liemesh bench`: β band (and Δt) shrunk by √(target / base).
+use liemesh::cli::workload_params as workload;
+use liemesh::model::LieField;
 use liemesh::preset::Preset;
 use liemesh::scalar::Dual;
-use liemesh::MeshParams;
 use spade::Triangulation as _;
 use std::hint::black_box;
 use std::time::Duration;
-
-/// Same scaling as `liemesh bench`: β band (and Δt) shrunk by √(target / base).
-fn workload(ellipsoid: bool, target: usize) -> (Invariant, MeshParams) {
-    let numbers: [f64; 6] = if ellipsoid {
-        [1.0, 4.0, 16.0, 0.0, 0.0, 0.0]
-    } else {
-        [1.0, 1.0, 1.0, 0.0, 0.0, 0.0]
-    };
-    let invariant = Invariant::from_numbers(&numbers).unwrap();
-    let mut params = Preset::Fig3.params();
-    let base = if ellipsoid { 9000.0 } else { 2000.0 };
-    let s = (target as f64 / base).sqrt();
-    params.beta_min /= s;
-    params.beta_max /= s;
-    params.dt /= s;
-    params.p0 = if ellipsoid {
-        [0.0, 0.0, 0.25]
-    } else {
-        [0.0, 0.0, 1.0]
-    };
-    (invariant, params)
-}
 
 fn configure<'a>(
     c: &'a mut Criterion,

@@ -15,7 +15,10 @@ use clap::{Parser, Subcommand};
 use std::process::ExitCode;
 use thiserror::Error;
 
-pub use bench::{fidelity_scan, FidelityScan, FIDELITY_LIMIT_DEG, FIDELITY_MAX_TRIANGLES};
+pub use bench::{
+    fidelity_scan, workload_params, FidelityScan, FIDELITY_CLOSER_GAP, FIDELITY_LIMIT_DEG,
+    FIDELITY_MAX_TRIANGLES,
+};
 pub use mesh::{mesh_invariant, MeshArgs, MeshOutcome};
 
 /// Adaptive meshes of surfaces defined by Lie-algebra invariants.

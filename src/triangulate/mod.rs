@@ -12,6 +12,9 @@
 //!    field normal: every triangle is oriented with the field normal.
 //! 4. In the default mode, edge flips make the result Delaunay on the surface itself, and a
 //!    tangential relaxation along the surface evens out the triangles.
+//! 5. With `MeshParams::max_normal_error`, faces whose normal strays further than that from
+//!    the field's are split (new vertices on the surface) until none does: see
+//!    [`Refinement`].
 
 mod flip;
 mod mesh;

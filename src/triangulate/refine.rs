@@ -34,7 +34,21 @@ pub const MAX_REFINE_ROUNDS: usize = 64;
 /// Most faces on one longest-edge propagation path.
 const MAX_PATH: usize = 64;
 
-/// What a refinement did.
+/// What a refinement to `MeshParams::max_normal_error` did ([`crate::MeshRun::refinement`]).
+///
+/// ```
+/// use liemesh::{model::{Invariant, LieField}, preset::Preset, quality::face_normal_error};
+///
+/// let sphere = Invariant::from_numbers(&[1.0, 1.0, 1.0, 0.0, 0.0, 0.0])?;
+/// let field = LieField::<f64>::new(&sphere);
+/// let mut params = Preset::Fig3.params();
+/// params.max_normal_error = Some(1f64.to_radians());
+/// let run = liemesh::run(&field, &params)?;
+/// let refinement = run.refinement.expect("asked for");
+/// assert!(refinement.added > 0 && refinement.over_limit == 0);
+/// assert!(face_normal_error(&field, &run.mesh).0 <= 1.0);
+/// # Ok::<(), Box<dyn std::error::Error>>(())
+/// ```
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
 pub struct Refinement {
     /// Rounds of splits made.
