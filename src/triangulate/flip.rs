@@ -258,19 +258,24 @@ impl HalfEdges {
     }
 
     /// Calls `visit` with every half-edge leaving `origin(start)`, one per triangle of its
-    /// fan, until `visit` returns true; returns that half-edge.
-    fn for_each_around(&self, start: u32, mut visit: impl FnMut(u32) -> bool) -> Option<u32> {
+    /// fan, until `visit` returns true; returns that half-edge, or else whether the fan
+    /// closed around the vertex (it is interior).
+    #[inline]
+    fn walk_fan(&self, start: u32, mut visit: impl FnMut(u32) -> bool) -> Result<u32, bool> {
         let mut h = start;
         // A fan has at most 3T triangles; the budget guards against a broken structure.
         let mut budget = self.twin.len() + 1;
         loop {
             if visit(h) {
-                return Some(h);
+                return Ok(h);
             }
             let t = self.twin[prev(h) as usize];
             budget -= 1;
-            if t == start || budget == 0 {
-                return None;
+            if t == start {
+                return Err(true);
+            }
+            if budget == 0 {
+                return Err(false);
             }
             if t == NONE {
                 break;
@@ -283,13 +288,19 @@ impl HalfEdges {
             let t = self.twin[h as usize];
             budget -= 1;
             if t == NONE || budget == 0 {
-                return None;
+                return Err(false);
             }
             h = next(t);
             if visit(h) {
-                return Some(h);
+                return Ok(h);
             }
         }
+    }
+
+    /// [`HalfEdges::walk_fan`] for the half-edge it finds.
+    #[inline]
+    fn for_each_around(&self, start: u32, visit: impl FnMut(u32) -> bool) -> Option<u32> {
+        self.walk_fan(start, visit).ok()
     }
 
     /// The half-edge `a → b`, if any.
@@ -375,31 +386,20 @@ impl HalfEdges {
     pub(super) fn star(&self, v: u32, faces: &mut Vec<u32>) -> bool {
         faces.clear();
         let start = self.out[v as usize];
-        if start == NONE {
-            return false;
-        }
-        // Forwards (to the twin of the incoming half-edge), then, if the fan is open,
-        // backwards from `start`; the length check guards against a broken structure.
-        let mut h = start;
-        loop {
-            faces.push(h / 3);
-            let t = self.twin[prev(h) as usize];
-            if t == start {
-                return true;
-            }
-            if t == NONE || faces.len() > self.tri.len() {
-                break;
-            }
-            h = t;
-        }
-        let mut h = start;
-        loop {
-            let t = self.twin[h as usize];
-            if t == NONE || faces.len() > self.tri.len() {
-                return false;
-            }
-            h = next(t);
-            faces.push(h / 3);
+        start != NONE
+            && self.walk_fan(start, |h| {
+                faces.push(h / 3);
+                false
+            }) == Err(true)
+    }
+
+    /// The half-edge `a → b`: `hint` if it still is that (a flip since it was noted may have
+    /// moved it), else found around `a`.
+    #[inline(always)]
+    fn locate(&self, a: u32, b: u32, hint: Option<u32>) -> Option<u32> {
+        match hint {
+            Some(h) if self.origin(h) == a && self.dest(h) == b => Some(h),
+            _ => self.find(a, b),
         }
     }
 
@@ -480,13 +480,8 @@ impl HalfEdges {
             if flips >= budget || visits > max_visits {
                 break;
             }
-            let h = if self.origin(h) == a && self.dest(h) == b {
-                h
-            } else {
-                match self.find(a, b) {
-                    Some(h) => h,
-                    None => continue,
-                }
+            let Some(h) = self.locate(a, b, Some(h)) else {
+                continue;
             };
             let g = self.twin[h as usize];
             if g == NONE {
@@ -640,12 +635,8 @@ pub(crate) fn flip_to_surface_delaunay(
         if flips >= budget || visits > max_visits {
             break;
         }
-        let h = match slot {
-            Some(h) if he.origin(h) == a && he.dest(h) == b => h,
-            _ => match he.find(a, b) {
-                Some(h) => h,
-                None => continue,
-            },
+        let Some(h) = he.locate(a, b, slot) else {
+            continue;
         };
         let g = he.twin[h as usize];
         if g == NONE {
