@@ -711,17 +711,26 @@ mod tests {
         sum.abs() / (a.norm() + 4.0 * b.norm() + e.norm())
     }
 
-    /// Everything `step` computes before the chord, at `p` with tangent direction `w_prev`.
-    fn chord_inputs(
+    /// The chord of `length` that `step` would take from `p` towards the tangent part of
+    /// `w_prev`.
+    fn chord_from(
         field: &LieField<f64>,
+        cfg: &StepConfig<f64>,
         p: &Vec3<f64>,
         w_prev: &Vec3<f64>,
-    ) -> (Vec3<f64>, Vec3<f64>, Vec3<f64>, f64) {
+        length: f64,
+    ) -> Chord<f64> {
         let (v, n, vlen) = unit_normal(field, p).unwrap();
         let w = project_tangent(w_prev, &n).unwrap();
         let (_, jw) = field.normal_and_jvp(p, &w);
         let kappa = w.dot(&jw) / vlen;
-        (v, n, w, kappa)
+        let start = ChordStart {
+            p,
+            v0: &v,
+            n: &n,
+            w: &w,
+        };
+        drift_free_chord(field, cfg, &start, &length, &kappa).unwrap()
     }
 
     #[test]
@@ -745,14 +754,7 @@ mod tests {
         ]);
         // The length the band asks for: Newton finds no root there.
         let chosen = 0.022763110203215635;
-        let (v, n, w, kappa) = chord_inputs(&field, &p, &w_prev);
-        let start = ChordStart {
-            p: &p,
-            v0: &v,
-            n: &n,
-            w: &w,
-        };
-        let full = drift_free_chord(&field, &cfg, &start, &chosen, &kappa).unwrap();
+        let full = chord_from(&field, &cfg, &p, &w_prev, chosen);
         assert!(!full.converged);
         assert!(simpson_residual(&field, &p, &full.point) > 1e-3);
 
@@ -801,15 +803,7 @@ mod tests {
             -0.013585284404352206,
             0.792167539041794,
         ]);
-        let (v, n, w, kappa) = chord_inputs(&field, &p, &w);
-        let length = 0.011841414060809012;
-        let start = ChordStart {
-            p: &p,
-            v0: &v,
-            n: &n,
-            w: &w,
-        };
-        let chord = drift_free_chord(&field, &cfg, &start, &length, &kappa).unwrap();
+        let chord = chord_from(&field, &cfg, &p, &w, 0.011841414060809012);
         assert!(chord.converged);
         assert!(chord.iterations <= 8, "{}", chord.iterations);
         let r = simpson_residual(&field, &p, &chord.point);

@@ -445,14 +445,21 @@ mod tests {
         params
     }
 
+    /// The sphere meshed with `params` but without refinement.
+    fn without_refinement(field: &LieField<f64>, params: &MeshParams) -> crate::MeshRun<f64> {
+        let params = MeshParams {
+            max_normal_error: None,
+            ..params.clone()
+        };
+        crate::run(field, &params).unwrap()
+    }
+
     #[test]
     fn refinement_brings_every_face_within_the_bound_and_keeps_the_sphere_closed() {
         let field = LieField::<f64>::new(&sphere());
-        let mut params = coarse_sphere(1.0);
-        params.max_normal_error = None;
-        let before = crate::generate(&field, &params).unwrap();
+        let params = coarse_sphere(1.0);
+        let before = without_refinement(&field, &params).mesh;
         assert!(face_normal_error(&field, &before).0 > 2.0);
-        params.max_normal_error = Some(1f64.to_radians());
         let run = crate::run(&field, &params).unwrap();
         let done = run.refinement.unwrap();
         assert!(done.added > 100 && done.over_limit == 0, "{done:?}");
@@ -482,14 +489,7 @@ mod tests {
         let mut params = coarse_sphere(1.0);
         params.terminal.close = false;
         params.terminal.max_radius = 1.2;
-        let unrefined = crate::run(
-            &field,
-            &MeshParams {
-                max_normal_error: None,
-                ..params.clone()
-            },
-        )
-        .unwrap();
+        let unrefined = without_refinement(&field, &params);
         let run = crate::run(&field, &params).unwrap();
         let done = run.refinement.unwrap();
         assert!(done.added > 10 && done.over_limit == 0, "{done:?}");
@@ -530,14 +530,7 @@ mod tests {
     fn refinement_stops_at_the_point_budget() {
         let field = LieField::<f64>::new(&sphere());
         let mut params = coarse_sphere(0.3);
-        let unrefined = crate::run(
-            &field,
-            &MeshParams {
-                max_normal_error: None,
-                ..params.clone()
-            },
-        )
-        .unwrap();
+        let unrefined = without_refinement(&field, &params);
         params.budget.max_points = unrefined.samples.points.len() + 40;
         let run = crate::run(&field, &params).unwrap();
         let done = run.refinement.unwrap();
