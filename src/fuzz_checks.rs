@@ -22,7 +22,7 @@ use crate::model::{Invariant, InvariantError, LieField};
 use crate::preset::Preset;
 use crate::quality::Topology;
 use crate::sample::{Curve, CurveEnd, Samples, StepRecord};
-use crate::scalar::f64x3::{cross as cross3, sub as sub3};
+use crate::geom::vec3::{cross as cross3, sub as sub3};
 use crate::scalar::Vec3;
 use crate::trace::StepLimit;
 use crate::triangulate::{ChartTriangulation, Mesh, Provenance};

@@ -28,9 +28,11 @@
 pub mod audit;
 pub mod cli;
 mod error;
+mod geom;
 #[doc(hidden)]
 pub mod fuzz_checks;
 pub mod io;
+pub mod mesh;
 pub mod model;
 mod par;
 mod params;
@@ -44,7 +46,7 @@ pub mod triangulate;
 pub use error::MeshError;
 pub use model::NormalField;
 pub use params::{Budget, MeshParams, Method, Mode, Terminal};
-pub use triangulate::{Mesh, Provenance};
+pub use mesh::{Mesh, Provenance};
 
 /// The README's examples, compiled and run as doctests.
 #[cfg(doctest)]

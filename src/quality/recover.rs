@@ -8,7 +8,7 @@
 //! scaled to the reference by least squares and decomposed as `A = diag(λ) Rx(θ) Ry(φ) Rz(ψ)`.
 
 use crate::model::Invariant;
-use crate::scalar::f64x3::{cross, dot, normalize, sub};
+use crate::geom::vec3::{cross, dot, normalize, sub};
 use crate::triangulate::Mesh;
 use nalgebra::{DMatrix, Matrix3};
 use serde::{Deserialize, Serialize};

@@ -5,7 +5,7 @@ use serde::{Deserialize, Serialize};
 use std::collections::HashMap;
 
 /// A fast hasher for edge keys (the counts do not depend on iteration order).
-type EdgeHash = crate::scalar::f64x3::FastHash;
+type EdgeHash = crate::geom::vec3::FastHash;
 
 /// Topological facts about a mesh.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]

@@ -1,7 +1,7 @@
 //! A uniform hash grid over points: O(1) neighbourhood queries for the gap and
 //! closure tests of the sampler.
 
-use crate::scalar::f64x3::FastHash;
+use crate::geom::vec3::FastHash;
 use std::collections::HashMap;
 
 type Cell = (i32, i32, i32);

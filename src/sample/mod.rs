@@ -12,10 +12,10 @@ mod grid;
 
 use crate::error::MeshError;
 use crate::params::{MeshParams, Method, Mode};
-use crate::scalar::f64x3::{dist, dot, sub};
+use crate::geom::vec3::{dist, dot, sub};
 use crate::scalar::{Scalar, Vec3};
 use crate::trace::{self, StepConfig, StepLimit};
-use crate::triangulate::Provenance;
+use crate::mesh::Provenance;
 use crate::NormalField;
 use grid::Grid;
 use std::cmp::Reverse;

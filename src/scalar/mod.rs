@@ -18,7 +18,6 @@
 //! ```
 
 mod dual;
-pub(crate) mod f64x3;
 #[cfg(feature = "mpfr")]
 mod mpfr;
 mod vec3;

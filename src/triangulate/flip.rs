@@ -9,7 +9,7 @@
 
 use super::rows_by_corner;
 use crate::par;
-use crate::scalar::f64x3::{cross, dot, sub, FastHash};
+use crate::geom::vec3::{cross, dot, sub, FastHash};
 use std::collections::{HashMap, VecDeque};
 
 /// Angle at `c` in triangle (a, b, c).

@@ -17,7 +17,6 @@
 //!    [`Refinement`].
 
 mod flip;
-mod mesh;
 mod refine;
 mod relax;
 mod reopen;
@@ -27,12 +26,12 @@ pub use refine::{Refinement, MAX_REFINE_ROUNDS};
 pub(crate) use relax::relax;
 
 #[cfg(test)]
-pub(crate) use mesh::octahedron;
-pub use mesh::{Mesh, Provenance};
+pub(crate) use crate::mesh::octahedron;
+pub use crate::mesh::{Mesh, Provenance};
 
 use crate::error::MeshError;
 use crate::sample::{CurveEnd, Samples};
-use crate::scalar::f64x3::{
+use crate::geom::vec3::{
     cross as cross3, dot as dot3, normalize as normalize3, sub as sub3, FastHash,
 };
 use crate::scalar::Scalar;

@@ -1,4 +1,4 @@
-//! The finished mesh: what every stage after triangulation reads.
+//! The finished mesh: what every stage after triangulation reads, and what the samples' provenance is recorded in.
 
 use serde::{Deserialize, Serialize};
 
