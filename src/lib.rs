@@ -68,6 +68,21 @@ pub struct MeshRun<T> {
     pub vertices: Vec<scalar::Vec3<T>>,
     /// What refinement to [`MeshParams::max_normal_error`] did, if it was asked for.
     pub refinement: Option<triangulate::Refinement>,
+    /// How long each stage took.
+    pub timings: Timings,
+}
+
+/// Wall-clock seconds each stage of [`run`] took.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Timings {
+    /// Tracing the curves (sampling).
+    pub sampling: f64,
+    /// The chart triangulation and stitching where fronts meet.
+    pub triangulating: f64,
+    /// Relaxation and edge flips (default mode).
+    pub improving: f64,
+    /// Refinement to a normal-error bound.
+    pub refining: f64,
 }
 
 /// Samples and triangulates the surface of `field` (the whole pipeline), keeping the
@@ -80,29 +95,46 @@ pub fn run<T: Scalar, F: NormalField<T>>(
     field: &F,
     params: &MeshParams,
 ) -> Result<MeshRun<T>, MeshError> {
+    let clock = std::time::Instant::now();
+    let mut timings = Timings::default();
+    let lap = |slot: &mut f64, since: &mut f64| {
+        let now = clock.elapsed().as_secs_f64();
+        *slot = now - *since;
+        *since = now;
+    };
+    let mut since = 0.0;
     let samples = sample::sample(field, params)?;
+    lap(&mut timings.sampling, &mut since);
     let improve = params.mode == Mode::Default;
     let (mut mesh, chart) = triangulate::triangulate(&samples, params.terminal.close, improve)?;
-    let mut vertices = if improve {
-        triangulate::relax(field, params, &samples, &mut mesh)
-    } else {
-        mesh.provenance
-            .iter()
-            .map(|pr| {
-                samples.points[samples.curves[pr.curve as usize].points[pr.step as usize] as usize]
-                    .clone()
-            })
-            .collect()
-    };
+    // The mesh's vertices in the working precision, found by provenance.
+    let mut vertices: Vec<scalar::Vec3<T>> = mesh
+        .provenance
+        .iter()
+        .map(|pr| {
+            samples.points[samples.curves[pr.curve as usize].points[pr.step as usize] as usize]
+                .clone()
+        })
+        .collect();
+    if params.terminal.close {
+        triangulate::stitch(field, params, &samples, &mut mesh, &mut vertices);
+    }
+    lap(&mut timings.triangulating, &mut since);
+    if improve && std::env::var("NORELAX").is_err() {
+        triangulate::relax(field, params, &mut mesh, &mut vertices);
+    }
+    lap(&mut timings.improving, &mut since);
     let refinement = params.max_normal_error.map(|limit| {
         triangulate::refine(field, params, limit.to_degrees(), &mut mesh, &mut vertices)
     });
+    lap(&mut timings.refining, &mut since);
     Ok(MeshRun {
         samples,
         chart,
         mesh,
         vertices,
         refinement,
+        timings,
     })
 }
 

@@ -5,7 +5,7 @@ use super::CliError;
 use crate::model::{Invariant, LieField, NormalField};
 use crate::preset::Preset;
 use crate::scalar::{Dual, Scalar};
-use crate::{MeshParams, Mode};
+use crate::MeshParams;
 use clap::Args;
 use serde::Serialize;
 use spade::Triangulation as _;
@@ -307,23 +307,13 @@ fn time_workload(
     repeats: usize,
 ) -> Result<WorkloadRow, CliError> {
     let field = LieField::<f64>::new(invariant);
-    let improve = params.mode == Mode::Default;
     let (mut ts, mut tt, mut tb) = (Vec::new(), Vec::new(), Vec::new());
     let (mut triangles, mut points) = (0, 0);
     for _ in 0..repeats {
-        let t0 = Instant::now();
-        let samples = crate::sample::sample(&field, params)?;
-        let t1 = Instant::now();
-        let (mut mesh, _) =
-            crate::triangulate::triangulate(&samples, params.terminal.close, improve)?;
-        if improve {
-            // The default mode's relaxation is part of the pipeline (`crate::run`).
-            std::hint::black_box(crate::triangulate::relax(
-                &field, params, &samples, &mut mesh,
-            ));
-        }
-        let t2 = Instant::now();
-        let chart: Vec<spade::Point2<f64>> = crate::triangulate::chart_points(&samples)
+        let run = crate::run(&field, params)?;
+        let samples = &run.samples;
+        let mesh = &run.mesh;
+        let chart: Vec<spade::Point2<f64>> = crate::triangulate::chart_points(samples)
             .into_iter()
             .map(|[x, y]| spade::Point2::new(x, y))
             .collect();
@@ -332,8 +322,9 @@ fn time_workload(
             .map_err(|e| CliError::Usage(format!("spade bulk load failed: {e:?}")))?;
         let t4 = Instant::now();
         std::hint::black_box(dt);
-        ts.push((t1 - t0).as_secs_f64());
-        tt.push((t2 - t1).as_secs_f64());
+        let t = run.timings;
+        ts.push(t.sampling);
+        tt.push(t.triangulating + t.improving + t.refining);
         tb.push((t4 - t3).as_secs_f64());
         triangles = mesh.triangles.len();
         points = samples.points.len();

@@ -107,6 +107,20 @@ impl<T: Scalar> Samples<T> {
 /// to a point that lies far away in the chart.
 const COLLISION_RADIUS: f64 = 0.6;
 
+/// The fence around a point laid far away in the chart: a disc in its tangent plane of this
+/// many step lengths (the larger of the two curves' steps) in radius…
+const FENCE_RADIUS: f64 = 1.0;
+/// …and this many in half-thickness.
+const FENCE_THICKNESS: f64 = 0.35;
+
+/// Steps a curve waits before inserting on a side again after a curve it inserted there
+/// merged at once.
+const COOLDOWN_STEPS: f64 = 4.0;
+
+/// A step clamped at `dt_min` whose predicted turn exceeds this many `β_max` ends its curve
+/// as singular.
+const SINGULAR_TURN: f64 = 2.0;
+
 /// Curves are advanced in order of arc length measured in units of `dt_min / ORDER_RESOLUTION`
 /// (ties by curve id), not of the exact `f64` arc length: curves that symmetry gives equal arc
 /// lengths (every curve on the sphere) would otherwise be ordered by rounding noise, and the
@@ -128,6 +142,11 @@ struct Live<T> {
     drift: f64,
     /// `(cos θ, sin θ)` of the curve's angle at `p0`: its points' chart direction.
     chart_dir: [f64; 2],
+    /// Arc length below which this curve inserts no curve on its left (0) and right (1)
+    /// side: set when a curve it inserted there merged right away (see [`COOLDOWN_STEPS`]).
+    cooldown: [f64; 2],
+    /// For an inserted curve: its parent and whether it lies on the parent's right.
+    inserted_from: Option<(u32, bool)>,
 }
 
 /// Samples the surface of `field` from `params.p0` (paper Steps 2–7).
@@ -184,6 +203,7 @@ pub fn sample<T: Scalar, F: NormalField<T>>(
             hit_point_budget: false,
         },
         pos: vec![params.p0],
+        nrm: vec![n0.to_f64()],
         chart: vec![[0.0, 0.0]],
         live: Vec::new(),
         heap: BinaryHeap::new(),
@@ -217,6 +237,8 @@ pub fn sample<T: Scalar, F: NormalField<T>>(
             active: true,
             drift: 0.0,
             chart_dir: [theta.cos(), theta.sin()],
+            cooldown: [0.0; 2],
+            inserted_from: None,
         });
         s.heap.push(Reverse((s.order_key(0.0), j)));
     }
@@ -241,6 +263,9 @@ struct Sampler<'a, T, F> {
     out: Samples<T>,
     /// `f64` copies of the points for the geometric tests.
     pos: Vec<[f64; 3]>,
+    /// Unit normals of the points in `f64` (the step's first-order prediction for stepped
+    /// points): the tangent planes the fence tests steps against.
+    nrm: Vec<[f64; 3]>,
     /// Chart positions of the points (as [`Samples::chart`] computes them), cached so that
     /// the closure test does no trigonometry per neighbour.
     chart: Vec<[f64; 2]>,
@@ -282,6 +307,16 @@ impl<T: Scalar, F: NormalField<T>> Sampler<'_, T, F> {
     }
 
     fn end_curve(&mut self, c: u32, end: CurveEnd) {
+        // An inserted curve that merges within a step or two was inserted where neighbours
+        // shear past each other: its parent waits before inserting on that side again, or it
+        // would insert (and lose) a curve at every step.
+        if end == CurveEnd::Merge && self.out.curves[c as usize].points.len() <= 2 {
+            if let Some((parent, right)) = self.live[c as usize].inserted_from {
+                let live = &mut self.live[parent as usize];
+                let wait = live.s + COOLDOWN_STEPS * live.dt.to_f64();
+                live.cooldown[usize::from(right)] = wait;
+            }
+        }
         let (l, r) = (self.live[c as usize].left, self.live[c as usize].right);
         self.live[c as usize].active = false;
         self.out.curves[c as usize].end = end;
@@ -310,6 +345,15 @@ impl<T: Scalar, F: NormalField<T>> Sampler<'_, T, F> {
         };
         let len = step.dt.to_f64();
         let q = step.point.to_f64();
+        // A step clamped at the smallest length that still turns the normal by more than
+        // twice the band's top is at a singular point (a cone's apex): the field's curvature
+        // grows without bound there, and the next step would jump across it.
+        if step.limit == StepLimit::Clamped
+            && len <= self.params.dt_min * (1.0 + 1e-9)
+            && step.alpha_predicted > SINGULAR_TURN * self.params.beta_max
+        {
+            return Some(CurveEnd::Singular);
+        }
         let s_new = live.s + len;
         if s_new > self.params.terminal.max_radius {
             return Some(CurveEnd::Radius);
@@ -323,7 +367,13 @@ impl<T: Scalar, F: NormalField<T>> Sampler<'_, T, F> {
         let chart_q = [s_new * dir[0], s_new * dir[1]];
         let drift = live.drift + 0.5 * len * step.alpha_predicted;
         let normal = (!self.drift.is_empty()).then(|| step.normal.to_f64());
-        if self.params.terminal.close && self.collides(q, chart_q, len, normal, drift) {
+        if self.params.terminal.close
+            && match normal {
+                // Paper mode: curves drift off the surface, by different amounts.
+                Some(_) => self.collides(q, chart_q, len, normal, drift),
+                None => self.crosses(live.p.to_f64(), q, chart_q, len),
+            }
+        {
             return Some(CurveEnd::Collision);
         }
         let proposed = self.params.method == Method::Proposed;
@@ -354,6 +404,7 @@ impl<T: Scalar, F: NormalField<T>> Sampler<'_, T, F> {
         });
         self.out.curves[ci].points.push(index);
         self.pos.push(q);
+        self.nrm.push(step.next_normal);
         self.chart.push(chart_q);
         self.grid.push(&self.pos);
         if !self.drift.is_empty() {
@@ -383,11 +434,22 @@ impl<T: Scalar, F: NormalField<T>> Sampler<'_, T, F> {
                 }
                 let live = &self.live[ci];
                 let k = if side_right { live.right } else { live.left };
-                if k == c || self.out.curves.len() >= budget.max_curves {
+                if k == c
+                    || self.out.curves.len() >= budget.max_curves
+                    || live.s < live.cooldown[usize::from(side_right)]
+                {
                     continue;
                 }
                 let (gap, target, s_target) = self.lateral_gap(k, q);
-                if gap > self.params.gap * len {
+                // Apart by more than `gap` steps, or with normals turned apart by more than
+                // `gap` times the band's top: where a curve runs along a flat direction its
+                // steps are long, and only the normals tell that its neighbours diverge.
+                let last_k = *self.out.curves[k as usize].points.last().expect("curves start with one point");
+                let turn = dot(self.nrm[index as usize], self.nrm[last_k as usize]).clamp(-1.0, 1.0).acos();
+                if gap > self.params.gap * len
+                    || (gap > self.params.merge * len.min(self.params.dt_max) * 2.0
+                        && turn > self.params.gap * self.params.beta_max)
+                {
                     self.insert_between(c, k, side_right, q, target, s_target, len);
                 }
             }
@@ -438,6 +500,44 @@ impl<T: Scalar, F: NormalField<T>> Sampler<'_, T, F> {
                 let cj = self.chart[j as usize];
                 let dc = ((cj[0] - chart_q[0]).powi(2) + (cj[1] - chart_q[1]).powi(2)).sqrt();
                 dc > 2.0 * d + len
+            }
+        })
+    }
+
+    /// The fence: whether the step `p → q` comes onto the sheet that curves far away in the
+    /// chart already swept — it ends within a thin disc about one of their points (in that
+    /// point's tangent plane), or passes through such a disc. Fronts that meet head-on (a
+    /// sphere's far side), side by side (an inserted curve beside the other side of a
+    /// cylinder's seam) or at an angle (a non-integrable field's sheet turning back through
+    /// itself) all stop there, before they overlap or cross what is laid.
+    fn crosses(&self, p: [f64; 3], q: [f64; 3], chart_q: [f64; 2], len: f64) -> bool {
+        // Every point within the fence radius of the segment is within this of its middle.
+        let e = sub(q, p);
+        let half = 0.5 * dot(e, e).sqrt();
+        let mid = [p[0] + 0.5 * e[0], p[1] + 0.5 * e[1], p[2] + 0.5 * e[2]];
+        let radius = FENCE_RADIUS * len;
+        let thickness = FENCE_THICKNESS * len;
+        let reach = half + radius;
+        self.grid.any_near(mid, reach, |j| {
+            let j = j as usize;
+            let xj = self.pos[j];
+            let dq = dist(q, xj);
+            if dq > half + reach {
+                return false;
+            }
+            let nj = self.nrm[j];
+            let (sp, sq) = (dot(sub(p, xj), nj), dot(sub(q, xj), nj));
+            let onto = sq.abs() < thickness && dq < radius;
+            let through = ((sp > 0.0 && sq < 0.0) || (sp < 0.0 && sq > 0.0)) && {
+                let t = sp / (sp - sq);
+                let c = [p[0] + t * e[0], p[1] + t * e[1], p[2] + t * e[2]];
+                dist(c, xj) < radius
+            };
+            // Far in the chart: not this curve's own recent points nor its neighbours'.
+            (onto || through) && {
+                let cj = self.chart[j];
+                let dc = ((cj[0] - chart_q[0]).powi(2) + (cj[1] - chart_q[1]).powi(2)).sqrt();
+                dc > 2.0 * dq + 2.0 * len
             }
         })
     }
@@ -536,14 +636,17 @@ impl<T: Scalar, F: NormalField<T>> Sampler<'_, T, F> {
         let chart_dir = [theta.cos(), theta.sin()];
         let chart = [s * chart_dir[0], s * chart_dir[1]];
         let drift = 0.5 * (self.live[c as usize].drift + self.live[k as usize].drift);
-        let normal = if self.drift.is_empty() {
-            None
-        } else {
-            trace::unit_normal(self.field, &start)
-                .ok()
-                .map(|(_, n, _)| n.to_f64())
+        let Ok((_, start_normal, _)) = trace::unit_normal(self.field, &start) else {
+            return;
         };
-        if self.params.terminal.close && self.collides(start_f, chart, len, normal, drift) {
+        let start_normal = start_normal.to_f64();
+        let normal = (!self.drift.is_empty()).then_some(start_normal);
+        if self.params.terminal.close
+            && match normal {
+                Some(_) => self.collides(start_f, chart, len, normal, drift),
+                None => self.crosses(start_f, start_f, chart, len),
+            }
+        {
             return;
         }
         let carry = (&self.live[c as usize].carry + &self.live[k as usize].carry)
@@ -567,6 +670,7 @@ impl<T: Scalar, F: NormalField<T>> Sampler<'_, T, F> {
             end: CurveEnd::Budget,
         });
         self.pos.push(start_f);
+        self.nrm.push(start_normal);
         self.chart.push(chart);
         self.grid.push(&self.pos);
         if !self.drift.is_empty() {
@@ -583,6 +687,8 @@ impl<T: Scalar, F: NormalField<T>> Sampler<'_, T, F> {
             active: true,
             drift,
             chart_dir,
+            cooldown: [0.0; 2],
+            inserted_from: Some((c, k_is_right)),
         });
         self.live[left as usize].right = id;
         self.live[right as usize].left = id;

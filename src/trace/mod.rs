@@ -101,6 +101,9 @@ pub struct Step<T> {
     pub dt: T,
     /// The predicted normal-turn angle α of the accepted Δt, radians.
     pub alpha_predicted: f64,
+    /// The first-order prediction of the unit normal at the new point, `v_i + Δt J_v w_i`
+    /// normalised, in `f64` (what the sampler's fence tests the other curves against).
+    pub next_normal: [f64; 3],
     /// How many Δt retries (paper) or Newton iterations (default, over every length tried)
     /// the step took.
     pub iterations: u32,
@@ -118,6 +121,18 @@ pub fn unit_normal<T: Scalar, F: NormalField<T>>(
     match v.normalize() {
         Some((n, len)) => Ok((v, n, len)),
         None => Err(StepStop::SingularNormal),
+    }
+}
+
+/// `normalize(v + Δt J_v w)` in `f64` (the zero vector if that vanishes or is not finite).
+fn predicted_normal<T: Scalar>(v: &Vec3<T>, jw: &Vec3<T>, dt: &T) -> [f64; 3] {
+    let (v, jw, dt) = (v.to_f64(), jw.to_f64(), dt.to_f64());
+    let u = [0, 1, 2].map(|k| v[k] + dt * jw[k]);
+    let len = (u[0] * u[0] + u[1] * u[1] + u[2] * u[2]).sqrt();
+    if len > 0.0 && len.is_finite() {
+        u.map(|x| x / len)
+    } else {
+        [0.0; 3]
     }
 }
 
@@ -185,6 +200,7 @@ pub fn step<T: Scalar, F: NormalField<T>>(
             }
             Ok(Step {
                 point,
+                next_normal: predicted_normal(&v, &jw, &dt),
                 carry: w.clone(),
                 tangent: w,
                 normal: n,
@@ -255,6 +271,7 @@ pub fn step<T: Scalar, F: NormalField<T>>(
                 .add_scaled(&-T::one(), &w);
             Ok(Step {
                 point: chord.point,
+                next_normal: predicted_normal(&v, &jw, &dt),
                 carry,
                 tangent: w,
                 normal: n,

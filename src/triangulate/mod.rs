@@ -19,6 +19,7 @@
 mod flip;
 mod refine;
 mod relax;
+mod stitch;
 mod reopen;
 
 pub(crate) use refine::refine;
@@ -32,9 +33,12 @@ pub use crate::mesh::{Mesh, Provenance};
 use crate::error::MeshError;
 use crate::sample::{CurveEnd, Samples};
 use crate::geom::vec3::{
-    cross as cross3, dot as dot3, normalize as normalize3, sub as sub3, FastHash,
+    cross as cross3, dist as dist3, dot as dot3, normalize as normalize3, sub as sub3, FastHash,
 };
-use crate::scalar::Scalar;
+use crate::params::MeshParams;
+use crate::scalar::{Scalar, Vec3};
+use crate::trace::StepConfig;
+use crate::NormalField;
 use spade::{ConstrainedDelaunayTriangulation, HasPosition, Point2, Triangulation as _};
 
 /// The chart-1 triangulation, kept for audits (empty-circumcircle checks, snapshots).
@@ -70,7 +74,7 @@ impl HasPosition for ChartVertex {
 /// module docs); without it the mesh is exactly the charts' triangulations (the paper).
 pub fn triangulate<T: Scalar>(
     samples: &Samples<T>,
-    close: bool,
+    _close: bool,
     improve: bool,
 ) -> Result<(Mesh, ChartTriangulation), MeshError> {
     check_samples(samples)?;
@@ -85,86 +89,27 @@ pub fn triangulate<T: Scalar>(
     let pos: Vec<[f64; 3]> = samples.points.iter().map(|p| p.to_f64()).collect();
 
     let mut triangles = chart_triangles(&chart, &front)?;
-    let closable = close && samples.front_closed() && front.len() >= 3;
-    let mut closing = Vec::new();
-    if closable {
-        let normals: Vec<[f64; 3]> = front
-            .iter()
-            .map(|&i| samples.normals[i as usize].to_f64())
-            .collect();
-        closing = close_hole(&front, &pos, &normals, &triangles);
-        if !stitches_cleanly(&triangles, &closing, n) {
-            // Better an honest hole than a non-manifold mesh.
-            closing.clear();
-        }
-    }
-
+    // Chart triangles far larger in space than the sampling around them span a place where the
+    // chart is not the surface: fronts that met, or ended far apart. The stitching below
+    // closes what is left between real neighbours.
+    let spacing = local_spacing(samples);
+    triangles.retain(|t| {
+        let h = t.iter().map(|&v| spacing[v as usize]).fold(0.0, f64::max);
+        (0..3).all(|k| {
+            let (a, b) = (t[k] as usize, t[(k + 1) % 3] as usize);
+            dist3(pos[a], pos[b]) <= CHART_EDGE_FACTOR * h
+        })
+    });
     let normals: Vec<[f64; 3]> = samples.normals.iter().map(|v| v.to_f64()).collect();
-    // Chart 1 (or what is kept of it) and a closing, flipped to surface Delaunay in place,
-    // with what the flip pass knows about folds.
-    let finish = |mut all: Vec<[u32; 3]>, closing: &[[u32; 3]]| {
-        all.extend_from_slice(closing);
-        let mut folded = None;
-        if improve {
-            let budget = 8 * all.len() + 64;
-            folded = flip::flip_to_surface_delaunay(&pos, &normals, &mut all, budget).folded;
-        }
-        // Every mesh the test suite makes checks the flags against a rescan.
-        debug_assert!(
-            folded.is_none_or(|f| f == folds(&all, &pos, &normals)),
-            "the flip pass's fold flags disagree with a rescan"
-        );
-        (all, folded)
-    };
-    // Whether finished triangles face against the field somewhere: the flip pass knows when
-    // it ran; otherwise look.
-    let still_folds = |all: &[[u32; 3]], folded: Option<bool>| {
-        folded.unwrap_or_else(|| folds(all, &pos, &normals))
-    };
-    // The finished triangles, once some closing (or none) is settled on.
-    let mut finished = None;
-    if !closing.is_empty() {
-        // Closing triangles across a thin, twisted hole can face against the field, and flips
-        // cannot always turn them round: then the hole stays open rather than folded. When
-        // flips around the hole already leave a fold there, the pass over the whole mesh
-        // would end the same way and is spared.
-        let local = improve && folds_near_the_hole(&triangles, &closing, &pos, &normals);
-        debug_assert!(
-            !local || {
-                let (all, folded) = finish(triangles.clone(), &closing);
-                still_folds(&all, folded)
-            },
-            "a closing that folds near the hole was unfolded by the whole mesh's flips"
-        );
-        if local {
-            closing.clear();
-        } else {
-            let (all, folded) = finish(triangles.clone(), &closing);
-            if still_folds(&all, folded) {
-                closing.clear();
-            } else {
-                finished = Some(all);
-            }
-        }
+    // Chart triangles that turn far from the field normal lie where the chart folds over
+    // (inserted curves' chart positions are interpolated): they go, with the triangles
+    // around them, and the stitching fills the hole in space.
+    drop_folds(&pos, &normals, &mut triangles);
+    let mut all = triangles.clone();
+    if improve {
+        let budget = 8 * all.len() + 64;
+        flip::flip_to_surface_delaunay(&pos, &normals, &mut all, budget);
     }
-    // A hole that would not close because chart 1 folds next to it (curves crossing a
-    // caustic) gets a second try: the folded triangles and their neighbours are filled
-    // together with the hole.
-    if closable && closing.is_empty() {
-        let accept = |kept: Vec<[u32; 3]>, fill: &[[u32; 3]]| {
-            if !stitches_cleanly(&kept, fill, n) {
-                return None;
-            }
-            let (all, folded) = finish(kept, fill);
-            (!still_folds(&all, folded)).then_some(all)
-        };
-        if let Some(r) = reopen::reclose(&front, &triangles, &pos, &normals, accept) {
-            triangles = r.kept;
-            closing = r.closing;
-            finished = Some(r.finished);
-        }
-    }
-    let mut all = finished.unwrap_or_else(|| finish(triangles.clone(), &closing).0);
     // Three points on a line in space (curves that ran straight along a degenerate field)
     // make a triangle of no area and no normal, however good it looks in the chart.
     all.retain(|t| {
@@ -178,9 +123,102 @@ pub fn triangulate<T: Scalar>(
             chart,
             triangles,
             front,
-            closing,
+            closing: Vec::new(),
         },
     ))
+}
+
+/// What [`stitch`] did: see [`stitch::stitch`].
+pub(crate) use stitch::Stitched;
+
+/// Stitches the chart mesh where its fronts meet (see the `stitch` module): triangles
+/// between boundary parts that face each other and, on an integrable field, new vertices on
+/// the surface where a gap has none. `vertices` holds the mesh's vertices in the working
+/// precision and grows with it.
+pub(crate) fn stitch<T: Scalar, F: NormalField<T>>(
+    field: &F,
+    params: &MeshParams,
+    samples: &Samples<T>,
+    mesh: &mut Mesh,
+    vertices: &mut Vec<Vec3<T>>,
+) -> Stitched {
+    // Vertices on a boundary the surface does not close across: ends of curves that ended on
+    // a terminal condition, a singular point or a budget.
+    let free: Vec<bool> = mesh
+        .provenance
+        .iter()
+        .map(|pr| {
+            let Some(curve) = samples.curves.get(pr.curve as usize) else {
+                return false;
+            };
+            pr.step as usize + 1 == curve.points.len()
+                && matches!(
+                    curve.end,
+                    CurveEnd::Radius | CurveEnd::BoundingBox | CurveEnd::Singular | CurveEnd::Budget
+                )
+        })
+        .collect();
+    let growth = stitch::Growth {
+        field,
+        cfg: StepConfig::new(params),
+        bounding_box: params.terminal.bounding_box,
+        max_radius: params.terminal.max_radius,
+        max_vertices: params.budget.max_points,
+        new_points: true,
+    };
+    stitch::stitch(mesh, vertices, &free, &growth)
+}
+
+/// Chart triangles whose normal is further than this from their corners' field normals are
+/// folds.
+const FOLD_DEG: f64 = 60.0;
+
+/// Removes the chart triangles that fold ([`FOLD_DEG`]) and every triangle that shares a
+/// corner with one.
+fn drop_folds(pos: &[[f64; 3]], normals: &[[f64; 3]], triangles: &mut Vec<[u32; 3]>) {
+    let limit = FOLD_DEG.to_radians().cos();
+    let mut bad = vec![false; pos.len()];
+    let mut any = false;
+    for &t in triangles.iter() {
+        if flip::agreement(pos, normals, t) < limit {
+            any = true;
+            for v in t {
+                bad[v as usize] = true;
+            }
+        }
+    }
+    if any {
+        triangles.retain(|t| !t.iter().any(|&v| bad[v as usize]));
+    }
+}
+
+/// A chart triangle is kept only if no edge is longer in space than this many times the
+/// largest [`local_spacing`] at its corners.
+const CHART_EDGE_FACTOR: f64 = 4.0;
+
+/// How far apart the samples are around each sample point: the longer of the steps into and
+/// out of it on its curve, and, when no curve was inserted (the previous method, whose
+/// curves spread apart with the radius), the arc between neighbouring curves at its radius.
+fn local_spacing<T>(samples: &Samples<T>) -> Vec<f64> {
+    let mut h = vec![0.0f64; samples.points.len()];
+    for curve in &samples.curves {
+        for (k, &i) in curve.points.iter().enumerate() {
+            let before = samples.steps[i as usize].dt;
+            let after = curve
+                .points
+                .get(k + 1)
+                .map_or(0.0, |&j| samples.steps[j as usize].dt);
+            let i = i as usize;
+            h[i] = h[i].max(before).max(after);
+        }
+    }
+    if samples.curves.iter().all(|c| c.parent.is_none()) && !samples.curves.is_empty() {
+        let arc = std::f64::consts::TAU / samples.curves.len() as f64;
+        for (i, pr) in samples.provenance.iter().enumerate() {
+            h[i] = h[i].max(pr.s * arc);
+        }
+    }
+    h
 }
 
 /// Relative radial offset of alternate curves' points in chart 1 (2⁻³⁰, about 10⁻⁹).
@@ -370,7 +408,7 @@ fn chart_triangles(chart: &[[f64; 2]], front: &[u32]) -> Result<Vec<[u32; 3]>, M
     let cdt = ConstrainedDelaunayTriangulation::<ChartVertex>::bulk_load(vertices)
         .map_err(|e| MeshError::Triangulation(format!("spade rejected a chart point: {e:?}")))?;
     let mut cdt = cdt;
-    if use_front {
+    if m >= 3 {
         // Handles by sample index (duplicates were merged by spade; map through the data).
         let mut handle = vec![None; chart.len()];
         for v in cdt.vertices() {
@@ -398,8 +436,19 @@ fn chart_triangles(chart: &[[f64; 2]], front: &[u32]) -> Result<Vec<[u32; 3]>, M
     } else {
         0.0
     };
+    // A front that is not star-shaped about p0 (curves that ended at very different radii)
+    // bounds the mesh all the same: inside by the even-odd rule.
+    let polygon: Vec<[f64; 2]> = if !use_front && m >= 3 {
+        front.iter().map(|&v| chart[v as usize]).collect()
+    } else {
+        Vec::new()
+    };
     let inside = |c: [f64; 2]| {
-        !use_front || c[0] * c[0] + c[1] * c[1] < disk || inside_star(chart, front, (a0, &rel), c)
+        if use_front {
+            c[0] * c[0] + c[1] * c[1] < disk || inside_star(chart, front, (a0, &rel), c)
+        } else {
+            polygon.is_empty() || point_in_polygon(&polygon, c)
+        }
     };
     // One pass in spade's order, straight into the result: beside the triangulation itself
     // (the peak of memory here), a list of face handles would cost as much as the result.

