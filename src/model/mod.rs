@@ -8,6 +8,8 @@
 
 mod field;
 mod invariant;
+mod shape;
 
 pub use field::{jacobian, FnField, LieField, NormalField};
 pub use invariant::{Invariant, InvariantError, InvariantKind, Lift, Mat3};
+pub use shape::{least_aligned_tangent, LocalShape};

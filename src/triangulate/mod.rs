@@ -20,6 +20,7 @@ mod flip;
 mod refine;
 mod relax;
 mod stitch;
+mod untangle;
 mod reopen;
 
 pub(crate) use refine::refine;
@@ -35,6 +36,7 @@ use crate::sample::{CurveEnd, Samples};
 use crate::geom::vec3::{
     cross as cross3, dist as dist3, dot as dot3, normalize as normalize3, sub as sub3, FastHash,
 };
+use crate::model::LocalShape;
 use crate::params::MeshParams;
 use crate::scalar::{Scalar, Vec3};
 use crate::trace::StepConfig;
@@ -128,6 +130,11 @@ pub fn triangulate<T: Scalar>(
     ))
 }
 
+/// A field whose [integrability defect](crate::model::LocalShape::integrability_defect) stays
+/// below this at the probed samples is integrable for the stitching (rounding leaves about
+/// 1e-16 on the model's integrable fields; a rotation of 0.001 rad leaves 1e-3).
+const INTEGRABLE_DEFECT: f64 = 1e-9;
+
 /// What [`stitch`] did: see [`stitch::stitch`].
 pub(crate) use stitch::Stitched;
 
@@ -158,13 +165,21 @@ pub(crate) fn stitch<T: Scalar, F: NormalField<T>>(
                 )
         })
         .collect();
+    // New points only on an integrable field: checked at p0 and at samples spread over the
+    // run (a field may be integrable near p0 and not farther out).
+    let probes = 16.min(samples.points.len()).max(1);
+    let integrable = (0..probes).all(|k| {
+        let i = k * samples.points.len() / probes;
+        LocalShape::at::<T, F>(field, samples.points[i].to_f64())
+            .is_none_or(|s| s.integrability_defect < INTEGRABLE_DEFECT)
+    });
     let growth = stitch::Growth {
         field,
         cfg: StepConfig::new(params),
         bounding_box: params.terminal.bounding_box,
         max_radius: params.terminal.max_radius,
         max_vertices: params.budget.max_points,
-        new_points: true,
+        new_points: integrable,
     };
     stitch::stitch(mesh, vertices, &free, &growth)
 }

@@ -161,6 +161,7 @@ pub(crate) fn stitch<T: Scalar, F: NormalField<T>>(
                 break;
             }
             steps += 1;
+            POPS.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
             // A new point goes in on trial: the tests read it like any vertex.
             let x = if c.x == NEW {
                 s.place_new_point(c.a, c.b)
@@ -201,6 +202,10 @@ pub(crate) fn stitch<T: Scalar, F: NormalField<T>>(
     }
     if std::env::var("STITCH_DEBUG").is_ok() {
         s.debug();
+    }
+    if std::env::var("STITCH_STATS").is_ok() {
+        use std::sync::atomic::Ordering::Relaxed;
+        eprintln!("stitch: pops {} refreshes {} visits {} added {} vertices {} removed {}", POPS.load(Relaxed), REFRESHES.load(Relaxed), VISITS.load(Relaxed), out.added, out.vertices, out.removed);
     }
     let Stitcher {
         pos, nrm, prov, mut tris, ..
@@ -386,7 +391,9 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
         // The nearest boundary vertices within reach, a bounded number of them: the work
         // per edge stays constant where boundary vertices crowd.
         let mut found = Vec::new();
+        REFRESHES.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
         self.points.near(mid, reach, |x| {
+            VISITS.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
             if x != a && x != b {
                 let d = dist(self.pos[x as usize], mid);
                 if d <= reach {
@@ -394,9 +401,13 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
                 }
             }
         });
-        found.sort_unstable_by(|p, q| p.0.total_cmp(&q.0).then(p.1.cmp(&q.1)));
-        found.dedup_by_key(|e| e.1);
-        for (_, x) in found.into_iter().take(MAX_CANDIDATES) {
+        let order = |p: &(f64, u32), q: &(f64, u32)| p.0.total_cmp(&q.0).then(p.1.cmp(&q.1));
+        if found.len() > MAX_CANDIDATES {
+            found.select_nth_unstable_by(MAX_CANDIDATES, order);
+            found.truncate(MAX_CANDIDATES);
+        }
+        found.sort_unstable_by(order);
+        for (_, x) in found {
             if !self.on_boundary(x) || self.rejected.contains(&(a, b, x)) {
                 continue;
             }
@@ -737,9 +748,6 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
             let Some(mut ring) = self.loop_from(start) else {
                 continue;
             };
-            if ring.iter().any(|&v| self.free[v as usize]) {
-                continue;
-            }
             while ring.len() >= 3 && ring.len() <= SMALL_HOLE {
                 let m = ring.len();
                 let mut best: Option<(f64, usize)> = None;
@@ -834,7 +842,10 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
                 };
                 (u, v) = (v, w);
             }
-            if ok && ring.iter().all(|&v| !self.free[v as usize]) {
+            // A loop on a terminal boundary is stuck only if it is short: a notch that the
+            // rim pinched off, not the rim itself.
+            let terminal = ring.iter().any(|&v| self.free[v as usize]);
+            if ok && (!terminal || ring.len() <= SMALL_HOLE) {
                 out.push(ring);
             }
         }
@@ -1155,3 +1166,6 @@ impl FaceGrid {
         }
     }
 }
+pub(crate) static REFRESHES: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
+pub(crate) static VISITS: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
+pub(crate) static POPS: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);

@@ -1,0 +1,175 @@
+//! The last step before a mesh leaves the pipeline: it must not pass through itself.
+//!
+//! The fence, the stitching's exact tests and the relaxation's orientation checks keep almost
+//! every mesh embedded, but relaxation moves and surface-Delaunay flips are judged locally and
+//! can still make two faces cross where the mesh is thin (a seam the stitching closed, a fold of
+//! a non-integrable field's sweep). Here the crossings are found exactly, over the whole mesh,
+//! and undone:
+//!
+//! 1. vertices of crossing faces that relaxation moved go back to where they were before it;
+//! 2. faces that still cross are removed — on a non-integrable field the swept surface ends
+//!    where it would cross itself —, pinched vertices are cut apart, and only the component of
+//!    `p0` (or the largest) is kept.
+//!
+//! What was removed is counted in [`Untangled`] and reported; a mesh that still crosses itself
+//! after [`UNTANGLE_ROUNDS`] rounds is an error, never an output.
+
+use super::stitch::unpinch;
+use crate::mesh::Mesh;
+use crate::scalar::{Scalar, Vec3};
+
+/// Rounds of finding crossings and undoing them.
+pub const UNTANGLE_ROUNDS: usize = 6;
+
+/// What untangling did.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+pub struct Untangled {
+    /// Vertices put back where they were before relaxation.
+    pub reverted: usize,
+    /// Faces removed because they crossed others, or were cut off with them.
+    pub removed: usize,
+    /// Crossing face pairs left (0 unless the rounds ran out).
+    pub left: usize,
+}
+
+/// Finds the crossings of `mesh` with `crossings` and undoes them (see the module docs).
+/// `before` holds each vertex's position before relaxation (in `f64` and the working
+/// precision) and its unit normal then, for the vertices relaxation may have moved.
+pub(crate) fn untangle<T: Scalar>(
+    mesh: &mut Mesh,
+    vertices: &mut [Vec3<T>],
+    before: Option<&Before<T>>,
+    crossings: impl Fn(&[[f64; 3]], &[[u32; 3]]) -> Vec<(usize, usize)>,
+) -> Untangled {
+    let mut done = Untangled::default();
+    let mut reverting = before.is_some();
+    for _ in 0..UNTANGLE_ROUNDS {
+        let pairs = crossings(&mesh.vertices, &mesh.triangles);
+        done.left = pairs.len();
+        if pairs.is_empty() {
+            return done;
+        }
+        let mut faces: Vec<usize> = pairs.iter().flat_map(|&(f, g)| [f, g]).collect();
+        faces.sort_unstable();
+        faces.dedup();
+        if let (true, Some(b)) = (reverting, before) {
+            let mut moved = 0;
+            for &f in &faces {
+                for v in mesh.triangles[f] {
+                    let v = v as usize;
+                    if v < b.positions.len() && mesh.vertices[v] != b.positions[v] {
+                        mesh.vertices[v] = b.positions[v];
+                        mesh.normals[v] = b.normals[v];
+                        vertices[v] = b.working[v].clone();
+                        moved += 1;
+                    }
+                }
+            }
+            done.reverted += moved;
+            if moved > 0 {
+                continue;
+            }
+            reverting = false;
+        }
+        let drop: std::collections::HashSet<usize> = faces.into_iter().collect();
+        let before_count = mesh.triangles.len();
+        let mut f = 0;
+        mesh.triangles.retain(|_| {
+            let keep = !drop.contains(&f);
+            f += 1;
+            keep
+        });
+        unpinch(&mut mesh.triangles);
+        keep_main_component(mesh);
+        done.removed += before_count - mesh.triangles.len();
+    }
+    done.left = crossings(&mesh.vertices, &mesh.triangles).len();
+    done
+}
+
+/// Positions and normals before relaxation.
+pub(crate) struct Before<T> {
+    pub(crate) positions: Vec<[f64; 3]>,
+    pub(crate) normals: Vec<[f64; 3]>,
+    pub(crate) working: Vec<Vec3<T>>,
+}
+
+/// Keeps only the faces of the component (faces connected through edges) that holds `p0`'s
+/// vertex, or the largest component when `p0` is on none. Vertices are kept (unreferenced).
+pub(crate) fn keep_main_component(mesh: &mut Mesh) {
+    let tris = &mesh.triangles;
+    if tris.is_empty() {
+        return;
+    }
+    let n = mesh.vertices.len();
+    // Union–find over vertices joined by edges: faces sharing an edge share two vertices,
+    // and a pinch-free mesh's components through vertices and through edges agree.
+    let mut parent: Vec<u32> = (0..n as u32).collect();
+    fn find(parent: &mut [u32], mut x: u32) -> u32 {
+        while parent[x as usize] != x {
+            parent[x as usize] = parent[parent[x as usize] as usize];
+            x = parent[x as usize];
+        }
+        x
+    }
+    for t in tris {
+        for k in 0..3 {
+            let (a, b) = (find(&mut parent, t[k]), find(&mut parent, t[(k + 1) % 3]));
+            if a != b {
+                parent[a.max(b) as usize] = a.min(b);
+            }
+        }
+    }
+    let mut size = vec![0usize; n];
+    for t in tris {
+        size[find(&mut parent, t[0]) as usize] += 1;
+    }
+    let p0 = mesh
+        .provenance
+        .iter()
+        .position(|pr| pr.curve == 0 && pr.step == 0)
+        .map(|v| find(&mut parent, v as u32))
+        .filter(|&r| size[r as usize] > 0);
+    let keep = p0.unwrap_or_else(|| {
+        (0..n as u32)
+            .max_by_key(|&r| (size[r as usize], std::cmp::Reverse(r)))
+            .unwrap_or(0)
+    });
+    mesh.triangles.retain(|t| find(&mut parent, t[0]) == keep);
+}
+
+/// Drops the vertices no face uses (and their working-precision twins), renumbering the rest
+/// in order.
+pub(crate) fn drop_unused<T>(mesh: &mut Mesh, vertices: &mut Vec<Vec3<T>>) {
+    let n = mesh.vertices.len();
+    let mut used = vec![false; n];
+    for t in &mesh.triangles {
+        for &v in t {
+            used[v as usize] = true;
+        }
+    }
+    if used.iter().all(|&u| u) {
+        return;
+    }
+    let mut remap = vec![u32::MAX; n];
+    let mut next = 0u32;
+    for v in 0..n {
+        if used[v] {
+            remap[v] = next;
+            next += 1;
+        }
+    }
+    let keep = |v: &usize| used[*v];
+    let mut k = 0;
+    mesh.vertices.retain(|_| (keep(&k), k += 1).0);
+    k = 0;
+    mesh.normals.retain(|_| (keep(&k), k += 1).0);
+    k = 0;
+    mesh.provenance.retain(|_| (keep(&k), k += 1).0);
+    k = 0;
+    vertices.retain(|_| (keep(&k), k += 1).0);
+    for t in &mut mesh.triangles {
+        *t = t.map(|v| remap[v as usize]);
+    }
+}
