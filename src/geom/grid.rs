@@ -55,9 +55,9 @@ impl Aabb {
             max: t[0],
         };
         for p in &t[1..] {
-            for k in 0..3 {
-                b.min[k] = b.min[k].min(p[k]);
-                b.max[k] = b.max[k].max(p[k]);
+            for (k, &x) in p.iter().enumerate() {
+                b.min[k] = b.min[k].min(x);
+                b.max[k] = b.max[k].max(x);
             }
         }
         // f64::min ignores a NaN; keep it visible so that the box counts as non-finite.
@@ -418,7 +418,8 @@ pub(crate) fn spatial_order(n: usize, at: impl Fn(usize) -> P3) -> Vec<u32> {
             }
         }
     }
-    if !(gmin[0] <= gmax[0]) {
+    // No finite point: the bounds are still ±∞ the wrong way round.
+    if gmin[0] > gmax[0] {
         return (0..n as u32).collect();
     }
     // 2^10 cells per axis over the points' box: fine enough for locality.
@@ -736,7 +737,15 @@ mod tests {
             grid.insert(i as u32, *b);
         }
         assert_eq!(grid.len(), boxes.len() - 1); // the NaN box is not kept
-                                                 // Remove every other face; queries see only the rest.
+        assert!(!grid.is_empty());
+        let t: Tri = [[0.0; 3], [0.1, 0.0, 0.0], [0.0, 0.1, 0.0]];
+        grid.query_triangle(&t, &mut out);
+        let b = Aabb::of_triangle(&t);
+        let expected: Vec<u32> = (0..boxes.len() as u32)
+            .filter(|&j| boxes[j as usize].overlaps(&b))
+            .collect();
+        assert_eq!(out, expected);
+        // Remove every other face; queries see only the rest.
         for i in (0..boxes.len() as u32).step_by(2) {
             grid.remove(i);
         }

@@ -537,7 +537,7 @@ mod tests {
             }
             let fast = InRange.orient3d(p[0], p[1], p[2], p[3]);
             assert_eq!(fast, exact::orient3d(p[0], p[1], p[2], p[3]));
-            let k = 700 - (i as i32 % 1400);
+            let k = 700 - (i % 1400);
             let s = |q: P3| q.map(|x| scale(x, k));
             assert_eq!(fast, Checked.orient3d(s(p[0]), s(p[1]), s(p[2]), s(p[3])));
             let q = |v: P3| [v[0], v[1]];

@@ -591,7 +591,10 @@ fn geometry<O: Orient + Sync>(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::audit::XorShift64;
+    use crate::geom::intersect::{faces_intersect, triangle_is_degenerate};
     use crate::mesh::octahedron;
+    use proptest::prelude::*;
 
     fn mesh(vertices: Vec<P3>, triangles: Vec<[u32; 3]>) -> Mesh {
         let n = vertices.len();
@@ -672,5 +675,189 @@ mod tests {
         assert_eq!(v.non_finite_vertices.examples, [5]);
         assert_eq!(v.faces, 8);
         assert!(!v.is_valid());
+    }
+
+    /// Self-intersections by testing every pair of faces that validation tests (proper,
+    /// finite, non-degenerate), without a broad phase.
+    fn brute_force(p: &[P3], t: &[[u32; 3]]) -> Vec<(usize, usize)> {
+        let ok = |f: &[u32; 3]| {
+            f.iter().all(|&i| (i as usize) < p.len())
+                && f[0] != f[1]
+                && f[1] != f[2]
+                && f[0] != f[2]
+                && !triangle_is_degenerate(f.map(|i| p[i as usize]))
+        };
+        let mut pairs = Vec::new();
+        for i in 0..t.len() {
+            for j in i + 1..t.len() {
+                if ok(&t[i]) && ok(&t[j]) && faces_intersect(p, t[i], t[j]) {
+                    pairs.push((i, j));
+                }
+            }
+        }
+        pairs
+    }
+
+    fn check_against_brute_force(p: Vec<P3>, t: Vec<[u32; 3]>) -> Validation {
+        let expected = brute_force(&p, &t);
+        let v = mesh(p, t).validate();
+        assert_eq!(v.self_intersections.count, expected.len(), "{v}");
+        let first: Vec<_> = expected.into_iter().take(MAX_EXAMPLES).collect();
+        assert_eq!(v.self_intersections.examples, first);
+        v
+    }
+
+    /// A random triangle soup: corners from a pool (so faces share vertices), some on a
+    /// coarse integer lattice (so that coincident, collinear and coplanar corners occur),
+    /// sizes spread over three orders of magnitude (so that the grid needs several levels).
+    fn soup(seed: u64, faces: usize, lattice: bool) -> (Vec<P3>, Vec<[u32; 3]>) {
+        let mut rng = XorShift64::new(seed);
+        let pool = 3 * faces / 2 + 3;
+        let mut p = Vec::with_capacity(pool);
+        while p.len() < pool {
+            let c = rng.in_cube(1.0);
+            let s = 10f64.powf(rng.uniform(-2.5, 0.0));
+            for _ in 0..3 {
+                let d = rng.in_cube(s);
+                let mut q = [c[0] + d[0], c[1] + d[1], c[2] + d[2]];
+                if lattice {
+                    q = q.map(|x| (x * 4.0).round() / 4.0);
+                }
+                p.push(q);
+            }
+        }
+        let t = (0..faces)
+            .map(|k| {
+                if rng.next_u64().is_multiple_of(3) {
+                    [0, 1, 2].map(|_| (rng.next_u64() % pool as u64) as u32)
+                } else {
+                    let b = (3 * k % (pool - 2)) as u32;
+                    [b, b + 1, b + 2]
+                }
+            })
+            .collect();
+        (p, t)
+    }
+
+    /// The octahedron subdivided `levels` times onto the unit sphere (a closed mesh).
+    fn geosphere(levels: usize) -> (Vec<P3>, Vec<[u32; 3]>) {
+        let (mut p, mut t) = octahedron();
+        for _ in 0..levels {
+            let mut mid = std::collections::HashMap::new();
+            let mut next = Vec::new();
+            for f in &t {
+                let mut m = [0u32; 3];
+                for k in 0..3 {
+                    let (a, b) = (f[k].min(f[(k + 1) % 3]), f[k].max(f[(k + 1) % 3]));
+                    m[k] = *mid.entry((a, b)).or_insert_with(|| {
+                        let (x, y) = (p[a as usize], p[b as usize]);
+                        let c = [0, 1, 2].map(|i| (x[i] + y[i]) / 2.0);
+                        let r = (c[0] * c[0] + c[1] * c[1] + c[2] * c[2]).sqrt();
+                        p.push(c.map(|x| x / r));
+                        p.len() as u32 - 1
+                    });
+                }
+                next.push([f[0], m[0], m[2]]);
+                next.push([f[1], m[1], m[0]]);
+                next.push([f[2], m[2], m[1]]);
+                next.push(m);
+            }
+            t = next;
+        }
+        (p, t)
+    }
+
+    #[test]
+    fn a_subdivided_sphere_is_closed_and_perturbing_it_agrees_with_brute_force() {
+        let (p, t) = geosphere(3);
+        let v = check_against_brute_force(p.clone(), t.clone());
+        assert!(v.is_closed(), "{v}");
+        assert_eq!(
+            (v.faces, v.euler_characteristic, v.genus()),
+            (512, 2, Some(0))
+        );
+        let mut rng = XorShift64::new(4);
+        let mut found = 0;
+        for amount in [0.02, 0.05, 0.1, 0.3] {
+            let q: Vec<P3> = p
+                .iter()
+                .map(|x| {
+                    let d = rng.in_cube(amount);
+                    [x[0] + d[0], x[1] + d[1], x[2] + d[2]]
+                })
+                .collect();
+            found += check_against_brute_force(q, t.clone())
+                .self_intersections
+                .count;
+        }
+        assert!(found > 0);
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig { cases: 48, ..ProptestConfig::default() })]
+
+        /// The broad phase loses no intersecting pair and invents none.
+        #[test]
+        fn self_intersections_agree_with_brute_force(
+            seed in any::<u64>(),
+            faces in 2usize..120,
+            lattice in any::<bool>(),
+        ) {
+            let (p, t) = soup(seed, faces, lattice);
+            check_against_brute_force(p, t);
+        }
+
+        /// Renumbering vertices and reordering faces renames the offenders, nothing else.
+        #[test]
+        fn renumbering_changes_only_the_names(seed in any::<u64>(), faces in 2usize..80) {
+            let (p, t) = soup(seed, faces, true);
+            let v = mesh(p.clone(), t.clone()).validate();
+            let mut rng = XorShift64::new(seed ^ 1);
+            let mut perm: Vec<u32> = (0..p.len() as u32).collect();
+            for i in (1..perm.len()).rev() {
+                perm.swap(i, (rng.next_u64() % (i as u64 + 1)) as usize);
+            }
+            let mut q = vec![[0.0; 3]; p.len()];
+            for (old, &new) in perm.iter().enumerate() {
+                q[new as usize] = p[old];
+            }
+            let u: Vec<[u32; 3]> = t.iter().rev().map(|f| f.map(|i| perm[i as usize])).collect();
+            let w = mesh(q, u).validate();
+            prop_assert_eq!(
+                (v.vertices, v.edges, v.faces, v.euler_characteristic, v.components),
+                (w.vertices, w.edges, w.faces, w.euler_characteristic, w.components)
+            );
+            prop_assert_eq!(v.boundary_loops, w.boundary_loops);
+            prop_assert_eq!(v.self_intersections.count, w.self_intersections.count);
+            prop_assert_eq!(v.degenerate_faces.count, w.degenerate_faces.count);
+            prop_assert_eq!(v.non_manifold_edges.count, w.non_manifold_edges.count);
+            prop_assert_eq!(v.non_manifold_vertices.count, w.non_manifold_vertices.count);
+            prop_assert_eq!(v.orientation_flips.count, w.orientation_flips.count);
+        }
+
+        /// Arbitrary indices and coordinates (NaN, infinities, extremes) never panic and
+        /// are reported.
+        #[test]
+        fn arbitrary_input_never_panics(
+            coords in proptest::collection::vec(
+                prop_oneof![
+                    any::<f64>(),
+                    -2.0f64..2.0,
+                    Just(0.0),
+                    Just(f64::NAN),
+                    Just(f64::MAX),
+                    Just(f64::MIN_POSITIVE),
+                ],
+                0..60,
+            ),
+            tris in proptest::collection::vec(any::<[u8; 3]>(), 0..40),
+        ) {
+            let p: Vec<P3> = coords.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect();
+            let t: Vec<[u32; 3]> = tris.iter().map(|f| f.map(|i| i as u32 % 24)).collect();
+            let v = mesh(p.clone(), t.clone()).validate();
+            let bad = t.iter().filter(|f| f.iter().any(|&i| i as usize >= p.len())).count();
+            prop_assert_eq!(v.out_of_range_faces.count, bad);
+            let _ = v.to_string();
+        }
     }
 }
