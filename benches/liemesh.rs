@@ -4,7 +4,9 @@
 //! relaxation, its flip pass and the assembly of the working-precision vertices),
 //! (c) fig6 sampling per scalar type, (d) spade's bulk load of the same chart points, and
 //! (e) the fidelity workload: the coarsest sphere and ellipsoid meshes within 0.7° of the
-//! field normals, refinement included, as `liemesh bench`'s scan finds them.
+//! field normals, refinement included, as `liemesh bench`'s scan finds them, and
+//! (f) `Mesh::validate` on the 10^5-triangle sphere and ellipsoid beside the meshing of the
+//! same mesh (validation should cost at most a quarter of it).
 
 use criterion::{
     criterion_group, criterion_main, BenchmarkId, Criterion, SamplingMode, Throughput,
@@ -144,5 +146,50 @@ fn fidelity(c: &mut Criterion) {
     g.finish();
 }
 
-criterion_group!(benches, presets, sizes, scalars, fidelity);
+fn validate(c: &mut Criterion) {
+    let mut g = configure(c, "validate");
+    g.sampling_mode(SamplingMode::Flat)
+        .measurement_time(Duration::from_secs(5));
+    for (ellipsoid, label) in [(false, "sphere"), (true, "ellipsoid")] {
+        let (inv, params) = workload(ellipsoid, 100_000);
+        let field = LieField::<f64>::new(&inv);
+        let mesh = liemesh::run(&field, &params).unwrap().mesh;
+        let v = mesh.validate();
+        assert!(v.is_closed(), "{label}: {v}");
+        // The ratio at a glance (best of five each), before criterion's own measurements.
+        let best = |f: &mut dyn FnMut()| {
+            (0..5)
+                .map(|_| {
+                    let t = std::time::Instant::now();
+                    f();
+                    t.elapsed().as_secs_f64()
+                })
+                .fold(f64::INFINITY, f64::min)
+        };
+        let meshing = best(&mut || {
+            black_box(liemesh::run(&field, &params).unwrap());
+        });
+        let validation = best(&mut || {
+            black_box(mesh.validate());
+        });
+        eprintln!(
+            "validate/{label}-1e5: {} triangles, validation {:.1} ms, meshing {:.1} ms, ratio {:.2}",
+            mesh.triangles.len(),
+            validation * 1e3,
+            meshing * 1e3,
+            validation / meshing
+        );
+        g.throughput(Throughput::Elements(mesh.triangles.len() as u64));
+        let id = format!("{label}-1e5");
+        g.bench_function(BenchmarkId::new("validate", &id), |b| {
+            b.iter(|| black_box(&mesh).validate())
+        });
+        g.bench_function(BenchmarkId::new("mesh", &id), |b| {
+            b.iter(|| liemesh::run(black_box(&field), &params).unwrap())
+        });
+    }
+    g.finish();
+}
+
+criterion_group!(benches, presets, sizes, scalars, fidelity, validate);
 criterion_main!(benches);

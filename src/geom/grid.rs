@@ -1,20 +1,24 @@
-//! Broad phase for triangle faces: a uniform grid of cubic cells over their bounding boxes.
+//! Broad phase for triangle faces: grids of cubic cells over their bounding boxes.
 //!
-//! Mesh triangles are nearly uniform in size, so a cell about as large as a typical box
-//! ([`cell_size`]: the median of the boxes' longest sides) files each face in a few cells
-//! and keeps a handful of faces per cell. A face whose box would cover more than
-//! [`MAX_CELLS_PER_FACE`] cells (an outlier) is kept on a separate list instead and compared
-//! by box with every face, so a few huge faces cost `O(n)` each rather than filling the grid.
-//! Cell coordinates are clamped to ±2²⁰ so that keys pack into a `u64` and huge coordinates
-//! cannot overflow; the clamp is monotone, so overlapping boxes still share a cell.
-//! Boxes with a non-finite coordinate are never filed and never reported.
+//! Mesh triangles are nearly uniform in size, but adaptive meshes (an ellipsoid's flat sides
+//! against its tips) still vary by a factor of fifty. So the grid has levels: level `l` has
+//! cells of side `h·4^l`, `h` about a typical box ([`cell_size`]: the median longest side),
+//! and a face lives at the lowest level whose cells are at least half its box's longest
+//! side, so it covers at most three cells per axis there. Faces at different levels meet
+//! at the coarser one, where the finer face is also filed, as a guest. A face beyond the
+//! last level ([`MAX_LEVELS`]) goes on an outlier list and is compared by box with every
+//! face. Cell coordinates are clamped to a window of 2¹⁹ cells per axis and level, so keys
+//! pack into a `u64` and huge coordinates cannot overflow; the clamp is monotone, so boxes
+//! that overlap still share a cell. Boxes with a non-finite coordinate are never filed and
+//! never reported.
 //!
 //! Two uses:
 //! * [`PairGrid`]: every pair of overlapping boxes of a whole mesh, each once (a pair is
-//!   reported in the cell holding the lowest corner of the boxes' intersection), by cell
-//!   ranges so that callers can split the work.
+//!   reported in the cell holding the lowest corner of the boxes' intersection, at the
+//!   coarser face's level), by ranges of cells so that callers can split the work. Built by a
+//!   radix sort of (cell, face) entries: no hashing.
 //! * [`FaceGrid`]: incremental — insert faces one at a time and ask, before inserting a new
-//!   triangle, which inserted faces' boxes overlap its box.
+//!   triangle, which inserted faces' boxes overlap its box (hashed cells per level).
 
 use super::intersect::Tri;
 use super::predicates::P3;
@@ -22,11 +26,16 @@ use super::vec3::FastHash;
 use std::collections::HashMap;
 use std::ops::Range;
 
-/// Most cells a face is filed in; larger faces go on the outlier list.
-pub(crate) const MAX_CELLS_PER_FACE: u64 = 64;
+/// Number of grid levels (cells grow fourfold per level); faces larger than the last
+/// level's cells are outliers.
+pub(crate) const MAX_LEVELS: usize = 20;
 
-/// Cell coordinates are clamped to `[−CLAMP, CLAMP]`.
-const CLAMP: i64 = 1 << 20;
+/// Cells per axis of one level's window (coordinates outside are clamped to its edge).
+const WINDOW: i64 = 1 << 19;
+
+/// A query box covering more cells than this at some level scans that level's faces instead.
+#[cfg_attr(not(test), allow(dead_code))]
+const MAX_QUERY_CELLS: u64 = 512;
 
 /// A closed axis-aligned box.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -46,9 +55,9 @@ impl Aabb {
             max: t[0],
         };
         for p in &t[1..] {
-            for k in 0..3 {
-                b.min[k] = b.min[k].min(p[k]);
-                b.max[k] = b.max[k].max(p[k]);
+            for (k, &x) in p.iter().enumerate() {
+                b.min[k] = b.min[k].min(x);
+                b.max[k] = b.max[k].max(x);
             }
         }
         // f64::min ignores a NaN; keep it visible so that the box counts as non-finite.
@@ -83,8 +92,8 @@ impl Aabb {
     }
 }
 
-/// A cell size for `boxes`: the median longest side of the finite boxes (half of them fit in
-/// one cell per axis), or a fallback when that is zero (all boxes points) or undefined.
+/// A cell size for `boxes`: the median longest side of the finite boxes, or a fallback when
+/// that is zero (most boxes points) or undefined.
 pub(crate) fn cell_size(boxes: &[Aabb]) -> f64 {
     let mut ext: Vec<f64> = boxes
         .iter()
@@ -108,144 +117,262 @@ pub(crate) fn cell_size(boxes: &[Aabb]) -> f64 {
     }
 }
 
-/// The cell index of coordinate `x` (clamped; `x` finite).
-#[inline]
-fn cell_of(x: f64, inv: f64) -> i64 {
-    // `as` saturates on overflow (±∞ → i64 bounds), and the clamp keeps keys packable.
-    ((x * inv).floor() as i64).clamp(-CLAMP, CLAMP)
-}
-
-#[inline]
-fn cell_range(b: &Aabb, inv: f64) -> ([i64; 3], [i64; 3]) {
-    let lo = [0, 1, 2].map(|k| cell_of(b.min[k], inv));
-    let hi = [0, 1, 2].map(|k| cell_of(b.max[k], inv));
-    (lo, hi)
-}
-
-#[inline]
-fn cell_count(lo: &[i64; 3], hi: &[i64; 3]) -> u64 {
-    (0..3).map(|k| (hi[k] - lo[k] + 1) as u64).product()
-}
-
-#[inline]
-fn key(c: [i64; 3]) -> u64 {
-    let u = |x: i64| (x + CLAMP) as u64;
-    (u(c[0]) << 42) | (u(c[1]) << 21) | u(c[2])
-}
-
-/// Calls `f` with every cell of the range.
-#[inline]
-fn for_cells(lo: [i64; 3], hi: [i64; 3], mut f: impl FnMut([i64; 3])) {
-    for x in lo[0]..=hi[0] {
-        for y in lo[1]..=hi[1] {
-            for z in lo[2]..=hi[2] {
-                f([x, y, z]);
-            }
-        }
-    }
-}
-
-/// `1 / cell`, with a usable value for any input.
-fn inverse(cell: f64) -> f64 {
-    let inv = 1.0 / cell;
-    if inv.is_finite() && inv > 0.0 {
-        inv
+/// A usable base cell side for any input.
+fn base_cell(cell: f64) -> f64 {
+    if cell.is_finite() && cell > 0.0 && (1.0 / cell).is_finite() {
+        cell
     } else {
         1.0
     }
 }
 
+/// The level of a box of longest side `extent` with base cell `h` (`None`: an outlier).
+#[inline]
+fn level_of(extent: f64, h: f64) -> Option<usize> {
+    let mut side = 2.0 * h;
+    for l in 0..MAX_LEVELS {
+        if extent <= side {
+            return Some(l);
+        }
+        side *= 4.0;
+    }
+    None
+}
+
+/// The cell index of coordinate `x` (finite) in cells of `1 / inv`.
+#[inline]
+fn cell_of(x: f64, inv: f64) -> i64 {
+    // floor by truncation: `f64::floor` is a libm call on baseline x86-64, and this runs for
+    // every filed cell. `as` saturates on overflow (±∞ → i64 bounds); callers clamp.
+    let y = x * inv;
+    let t = y as i64;
+    if (t as f64) > y {
+        t - 1
+    } else {
+        t
+    }
+}
+
+/// `x`'s low 21 bits spread to every third bit (Morton interleaving).
+#[inline]
+fn spread3(x: u64) -> u64 {
+    let mut x = x & 0x1f_ffff;
+    x = (x | x << 32) & 0x001f_0000_0000_ffff;
+    x = (x | x << 16) & 0x001f_0000_ff00_00ff;
+    x = (x | x << 8) & 0x100f_00f0_0f00_f00f;
+    x = (x | x << 4) & 0x10c3_0c30_c30c_30c3;
+    x = (x | x << 2) & 0x1249_2492_4924_9249;
+    x
+}
+
+/// The Morton code of a cell: cells near in space get near codes, so sorted entries of
+/// neighbouring cells read nearby faces.
+#[inline]
+fn morton(c: [u32; 3]) -> u64 {
+    spread3(c[0] as u64) << 2 | spread3(c[1] as u64) << 1 | spread3(c[2] as u64)
+}
+
+/// One level of a [`PairGrid`]: its cell size and the window of cells its keys cover.
+#[derive(Clone, Copy, Debug)]
+struct Level {
+    inv: f64,
+    /// Lowest cell of the window, per axis.
+    lo: [i64; 3],
+    /// Bits per axis of the window (2^bits cells).
+    bits: u32,
+    /// First key of this level.
+    offset: u64,
+}
+
+impl Level {
+    /// A level of cells of side `side` whose window covers `[gmin, gmax]` (clamped to
+    /// [`WINDOW`] cells per axis).
+    fn new(side: f64, gmin: &P3, gmax: &P3, offset: u64) -> Level {
+        let inv = 1.0 / side;
+        let lo = [0, 1, 2].map(|k| cell_of(gmin[k], inv));
+        let span = (0..3)
+            .map(|k| {
+                (cell_of(gmax[k], inv) as i128 - lo[k] as i128 + 1).clamp(1, WINDOW as i128) as u64
+            })
+            .max()
+            .unwrap_or(1);
+        let bits = 64 - (span - 1).leading_zeros();
+        Level {
+            inv,
+            lo,
+            bits,
+            offset,
+        }
+    }
+    /// Number of keys of this level.
+    fn size(&self) -> u64 {
+        1 << (3 * self.bits)
+    }
+    /// The clamped cell of `p`, relative to the window.
+    #[inline]
+    fn cell(&self, p: &P3) -> [u32; 3] {
+        let top = (1i64 << self.bits) - 1;
+        let c = |k: usize| {
+            cell_of(p[k], self.inv)
+                .saturating_sub(self.lo[k])
+                .clamp(0, top) as u32
+        };
+        [c(0), c(1), c(2)]
+    }
+}
+
+/// Bits of a [`PairGrid`] entry below the face id: the three "lowest cell of the face's
+/// range on this axis" flags.
+const FLAG_BITS: u32 = 3;
+
 /// All overlapping pairs of a fixed set of boxes (face `i` is `boxes[i]`).
+///
+/// Each entry is one `u64`: the cell's key (level offset plus Morton code), a guest flag,
+/// the face id, and for each axis whether the cell is the lowest the face covers on it.
+/// A pair of faces filed together is reported in the cell that is the lowest of both on
+/// every axis — where the lowest corner of their boxes' intersection lies — which the flags
+/// tell without reading the boxes. Sorting on the guest flag too puts a cell's own faces
+/// before its guests, so guest pairs (which meet at their own level) are never visited.
 pub(crate) struct PairGrid<'a> {
     boxes: &'a [Aabb],
-    inv: f64,
-    /// Coordinates of each occupied cell.
-    cells: Vec<[i64; 3]>,
-    /// Faces of cell `c` are `entries[starts[c]..starts[c + 1]]`, ascending.
-    starts: Vec<u32>,
-    entries: Vec<u32>,
+    /// Entries sorted by key, faces ascending within a cell.
+    filed: Vec<u64>,
+    /// Start of each occupied cell's entries in `filed`, then the end.
+    runs: Vec<u32>,
     /// Outliers, ascending.
     big: Vec<u32>,
+    /// Position of the guest flag.
+    guest_bit: u32,
 }
 
 impl<'a> PairGrid<'a> {
-    /// Files `boxes` in cells of side `cell` (see [`cell_size`]).
+    /// Files `boxes` in levels of cells with base side `cell` (see [`cell_size`]). Boxes in
+    /// a spatial order ([`spatial_order`]) make the pair loop read nearby memory.
     pub fn new(boxes: &'a [Aabb], cell: f64) -> PairGrid<'a> {
-        let inv = inverse(cell);
-        let mut ids: HashMap<u64, u32, FastHash> =
-            HashMap::with_capacity_and_hasher(boxes.len(), FastHash::default());
-        let mut cells = Vec::new();
-        let mut filed: Vec<(u32, u32)> = Vec::with_capacity(3 * boxes.len());
-        let mut big = Vec::new();
-        for (i, b) in boxes.iter().enumerate() {
-            if !b.is_finite() {
-                continue;
+        let id_bits = 64 - (boxes.len() as u64).leading_zeros();
+        let guest_bit = id_bits + FLAG_BITS;
+        let tag_bits = guest_bit + 1;
+        let mut h = base_cell(cell);
+        let (mut gmin, mut gmax) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
+        for b in boxes.iter().filter(|b| b.is_finite()) {
+            for k in 0..3 {
+                gmin[k] = gmin[k].min(b.min[k]);
+                gmax[k] = gmax[k].max(b.max[k]);
             }
-            let (lo, hi) = cell_range(b, inv);
-            if cell_count(&lo, &hi) > MAX_CELLS_PER_FACE {
-                big.push(i as u32);
-                continue;
-            }
-            for_cells(lo, hi, |c| {
-                let next = cells.len() as u32;
-                let id = *ids.entry(key(c)).or_insert(next);
-                if id == next {
-                    cells.push(c);
+        }
+        // Levels whose keys fit beside the tags in 64 bits; coarser cells if they do not
+        // (any cell size is correct, only slower).
+        let (level, big, levels, used) = loop {
+            let mut level = vec![u8::MAX; boxes.len()];
+            let mut big = Vec::new();
+            let mut used = [false; MAX_LEVELS];
+            for (i, b) in boxes.iter().enumerate() {
+                if !b.is_finite() {
+                    continue;
                 }
-                filed.push((id, i as u32));
-            });
+                match level_of(b.extent(), h) {
+                    Some(l) => {
+                        level[i] = l as u8;
+                        used[l] = true;
+                    }
+                    None => big.push(i as u32),
+                }
+            }
+            let top = used.iter().rposition(|&u| u).map_or(0, |l| l + 1);
+            let mut levels = Vec::with_capacity(top);
+            let (mut offset, mut side) = (0u64, h);
+            for _ in 0..top {
+                let l = Level::new(side, &gmin, &gmax, offset);
+                offset = offset.saturating_add(l.size());
+                levels.push(l);
+                side *= 4.0;
+            }
+            let key_bits = 64 - offset.leading_zeros();
+            if key_bits + tag_bits <= 64 {
+                break (level, big, levels, used);
+            }
+            if !(h * 2.0).is_finite() {
+                // Cannot happen for finite boxes (one cell per axis fits); stay correct anyway.
+                let all = (0..boxes.len() as u32).filter(|&i| boxes[i as usize].is_finite());
+                break (level, all.collect(), Vec::new(), used);
+            }
+            h *= 2.0;
+        };
+        let mut filed: Vec<u64> = Vec::with_capacity(4 * boxes.len());
+        for (i, b) in boxes.iter().enumerate() {
+            let l = level[i] as usize;
+            if l >= levels.len() {
+                continue;
+            }
+            // At its own level, and as a guest at every coarser occupied level.
+            for (lv, lev) in levels.iter().enumerate().skip(l) {
+                if lv > l && !used[lv] {
+                    continue;
+                }
+                let id = ((lv > l) as u64) << guest_bit | (i as u64) << FLAG_BITS;
+                let (lo, hi) = (lev.cell(&b.min), lev.cell(&b.max));
+                for x in lo[0]..=hi[0] {
+                    for y in lo[1]..=hi[1] {
+                        for z in lo[2]..=hi[2] {
+                            let low = (x == lo[0]) as u64
+                                | ((y == lo[1]) as u64) << 1
+                                | ((z == lo[2]) as u64) << 2;
+                            let key = lev.offset + morton([x, y, z]);
+                            filed.push(key << tag_bits | id | low);
+                        }
+                    }
+                }
+            }
         }
-        // Counting sort by cell; faces stay ascending within a cell.
-        let mut starts = vec![0u32; cells.len() + 1];
-        for &(c, _) in &filed {
-            starts[c as usize + 1] += 1;
+        let key_bits = levels
+            .last()
+            .map_or(0, |l| 64 - (l.offset + l.size() - 1).leading_zeros());
+        radix_sort(&mut filed, guest_bit, tag_bits + key_bits);
+        let mut runs = Vec::new();
+        // A run is a cell: same key, natives then guests.
+        for (n, &e) in filed.iter().enumerate() {
+            if n == 0 || filed[n - 1] >> tag_bits != e >> tag_bits {
+                runs.push(n as u32);
+            }
         }
-        for c in 0..cells.len() {
-            starts[c + 1] += starts[c];
-        }
-        let mut fill = starts.clone();
-        let mut entries = vec![0u32; filed.len()];
-        for &(c, i) in &filed {
-            entries[fill[c as usize] as usize] = i;
-            fill[c as usize] += 1;
-        }
+        runs.push(filed.len() as u32);
         PairGrid {
             boxes,
-            inv,
-            cells,
-            starts,
-            entries,
+            filed,
+            runs,
             big,
+            guest_bit,
         }
     }
 
     /// Number of occupied cells (the range of [`PairGrid::pairs_in_cells`]).
     pub fn cells(&self) -> usize {
-        self.cells.len()
-    }
-
-    /// Number of outliers.
-    pub fn outliers(&self) -> usize {
-        self.big.len()
+        self.runs.len() - 1
     }
 
     /// Calls `f(i, j)`, `i < j`, for the overlapping pairs of filed faces whose lowest common
-    /// corner lies in one of the cells `range`; over all cells, every such pair exactly once.
+    /// corner lies in one of the cells `range` (at the coarser face's level); over all cells,
+    /// every such pair exactly once.
     pub fn pairs_in_cells(&self, range: Range<usize>, mut f: impl FnMut(u32, u32)) {
+        let ids = (1u64 << (self.guest_bit - FLAG_BITS)) - 1;
+        let id = |e: u64| ((e >> FLAG_BITS) & ids) as u32;
         for c in range {
-            let cell = self.cells[c];
-            let faces = &self.entries[self.starts[c] as usize..self.starts[c + 1] as usize];
-            for (n, &i) in faces.iter().enumerate() {
-                let bi = &self.boxes[i as usize];
-                for &j in &faces[n + 1..] {
-                    let bj = &self.boxes[j as usize];
-                    if !bi.overlaps(bj) {
+            let run = &self.filed[self.runs[c] as usize..self.runs[c + 1] as usize];
+            for (n, &a) in run.iter().enumerate() {
+                // Natives come first; from the first guest on, every pair is two guests.
+                if a >> self.guest_bit & 1 == 1 {
+                    break;
+                }
+                let ia = id(a);
+                let ba = &self.boxes[ia as usize];
+                for &b in &run[n + 1..] {
+                    // Reported only in the cell that is both faces' lowest on every axis.
+                    if (a | b) & 7 != 7 {
                         continue;
                     }
-                    // Report the pair only in the cell of the lowest common corner.
-                    let home = [0, 1, 2].map(|k| cell_of(bi.min[k].max(bj.min[k]), self.inv));
-                    if home == cell {
-                        f(i, j);
+                    let ib = id(b);
+                    if ba.overlaps(&self.boxes[ib as usize]) {
+                        f(ia.min(ib), ia.max(ib));
                     }
                 }
             }
@@ -270,35 +397,138 @@ impl<'a> PairGrid<'a> {
     }
 
     /// Calls `f(i, j)`, `i < j`, once for every pair of overlapping finite boxes.
+    #[cfg_attr(not(test), allow(dead_code))]
     pub fn for_each_pair(&self, mut f: impl FnMut(u32, u32)) {
         self.pairs_in_cells(0..self.cells(), &mut f);
         self.pairs_with_outliers(f);
     }
 }
 
+/// `0..n` in the Morton order of the points `at(i)` (non-finite points last), so that items
+/// near in space can be stored near in memory. `at` is called twice per item.
+pub(crate) fn spatial_order(n: usize, at: impl Fn(usize) -> P3) -> Vec<u32> {
+    let (mut gmin, mut gmax) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
+    let finite = |c: &P3| c.iter().all(|x| x.is_finite());
+    for i in 0..n {
+        let c = at(i);
+        if finite(&c) {
+            for k in 0..3 {
+                gmin[k] = gmin[k].min(c[k]);
+                gmax[k] = gmax[k].max(c[k]);
+            }
+        }
+    }
+    // No finite point: the bounds are still ±∞ the wrong way round.
+    if gmin[0] > gmax[0] {
+        return (0..n as u32).collect();
+    }
+    // 2^10 cells per axis over the points' box: fine enough for locality.
+    let side = (0..3).map(|k| gmax[k] - gmin[k]).fold(0.0, f64::max) / 1023.0;
+    let level = Level::new(base_cell(side), &gmin, &gmax, 0);
+    let id_bits = 64 - (n as u64).leading_zeros();
+    let mut keyed: Vec<u64> = (0..n)
+        .map(|i| {
+            let c = at(i);
+            let key = if finite(&c) {
+                morton(level.cell(&c))
+            } else {
+                level.size()
+            };
+            key << id_bits | i as u64
+        })
+        .collect();
+    let key_bits = 64 - level.size().leading_zeros();
+    radix_sort(&mut keyed, id_bits, id_bits + key_bits);
+    keyed
+        .into_iter()
+        .map(|e| (e & ((1 << id_bits) - 1)) as u32)
+        .collect()
+}
+
+/// Stable least-significant-digit radix sort of `v` by bits `lo..hi` (11 bits a pass).
+pub(crate) fn radix_sort(v: &mut Vec<u64>, lo: u32, hi: u32) {
+    const DIGIT: u32 = 11;
+    let mut buf = vec![0u64; v.len()];
+    let mut shift = lo;
+    while shift < hi {
+        let mut count = vec![0usize; (1 << DIGIT) + 1];
+        let digit = |e: u64| ((e >> shift) & ((1 << DIGIT) - 1)) as usize;
+        for &e in v.iter() {
+            count[digit(e) + 1] += 1;
+        }
+        for d in 0..1 << DIGIT {
+            count[d + 1] += count[d];
+        }
+        for &e in v.iter() {
+            let d = digit(e);
+            buf[count[d]] = e;
+            count[d] += 1;
+        }
+        std::mem::swap(v, &mut buf);
+        shift += DIGIT;
+    }
+}
+
 /// An incremental grid: faces are inserted (and removed) by id, and queried by box.
 ///
-/// Ids index an internal table, so they should be dense (face indices); the table grows to
-/// the largest id inserted.
+/// Each face lives at its level (as in [`PairGrid`]) in hashed cells; a query visits the
+/// cells its box covers at every occupied level, or scans a level's faces when its box
+/// covers more than a few hundred of that level's cells. Ids index an internal table, so
+/// they should be dense (face indices); the table grows to the largest id inserted.
+// The mesher's incremental check (next step) is its user; tested here.
+#[cfg_attr(not(test), allow(dead_code))]
 pub(crate) struct FaceGrid {
-    inv: f64,
-    cells: HashMap<u64, Vec<u32>, FastHash>,
+    h: f64,
+    /// Cells per level, keyed by packed (clamped) cell coordinates.
+    cells: Vec<HashMap<u64, Vec<u32>, FastHash>>,
+    /// Faces per level, for scans.
+    members: Vec<Vec<u32>>,
+    /// Outliers (larger than the last level's cells).
     big: Vec<u32>,
-    boxes: Vec<Option<Aabb>>,
+    /// Box and level of each inserted id.
+    boxes: Vec<Option<(Aabb, u8)>>,
     len: usize,
 }
 
+/// Packed key of a cell, clamped to ±2²⁰ per axis (monotone).
+#[inline]
+// The mesher's incremental check (next step) is its user; tested here.
+#[cfg_attr(not(test), allow(dead_code))]
+fn hash_key(c: [i64; 3]) -> u64 {
+    let u = |x: i64| (x.clamp(-(1 << 20), 1 << 20) + (1 << 20)) as u64;
+    (u(c[0]) << 42) | (u(c[1]) << 21) | u(c[2])
+}
+
+/// Clamped cell range of `b` in cells of `1 / inv`, and its number of cells.
+#[inline]
+// The mesher's incremental check (next step) is its user; tested here.
+#[cfg_attr(not(test), allow(dead_code))]
+fn hash_range(b: &Aabb, inv: f64) -> ([i64; 3], [i64; 3], u64) {
+    let c = |x: f64| cell_of(x, inv).clamp(-(1 << 20), 1 << 20);
+    let lo = [0, 1, 2].map(|k| c(b.min[k]));
+    let hi = [0, 1, 2].map(|k| c(b.max[k]));
+    let n = (0..3).map(|k| (hi[k] - lo[k] + 1) as u64).product();
+    (lo, hi, n)
+}
+
+// The mesher's incremental check (next step) is its user; tested here.
+#[cfg_attr(not(test), allow(dead_code))]
 impl FaceGrid {
-    /// An empty grid with cells of side `cell` (e.g. a typical edge length; see
+    /// An empty grid with base cells of side `cell` (e.g. a typical edge length; see
     /// [`cell_size`]).
     pub fn new(cell: f64) -> FaceGrid {
         FaceGrid {
-            inv: inverse(cell),
-            cells: HashMap::default(),
+            h: base_cell(cell),
+            cells: Vec::new(),
+            members: Vec::new(),
             big: Vec::new(),
             boxes: Vec::new(),
             len: 0,
         }
+    }
+
+    fn inv(&self, level: usize) -> f64 {
+        1.0 / (self.h * 4f64.powi(level as i32))
     }
 
     /// Number of faces in the grid.
@@ -322,37 +552,56 @@ impl FaceGrid {
         if self.boxes.len() <= i {
             self.boxes.resize(i + 1, None);
         }
-        self.boxes[i] = Some(b);
         self.len += 1;
-        let (lo, hi) = cell_range(&b, self.inv);
-        if cell_count(&lo, &hi) > MAX_CELLS_PER_FACE {
+        let Some(l) = level_of(b.extent(), self.h) else {
+            self.boxes[i] = Some((b, u8::MAX));
             self.big.push(id);
             return;
+        };
+        self.boxes[i] = Some((b, l as u8));
+        if self.cells.len() <= l {
+            self.cells.resize_with(l + 1, HashMap::default);
+            self.members.resize_with(l + 1, Vec::new);
         }
-        let cells = &mut self.cells;
-        for_cells(lo, hi, |c| cells.entry(key(c)).or_default().push(id));
+        self.members[l].push(id);
+        let (lo, hi, _) = hash_range(&b, self.inv(l));
+        let cells = &mut self.cells[l];
+        for x in lo[0]..=hi[0] {
+            for y in lo[1]..=hi[1] {
+                for z in lo[2]..=hi[2] {
+                    cells.entry(hash_key([x, y, z])).or_default().push(id);
+                }
+            }
+        }
     }
 
     /// Removes face `id` (nothing if absent).
     pub fn remove(&mut self, id: u32) {
-        let Some(b) = self.boxes.get_mut(id as usize).and_then(Option::take) else {
+        let Some((b, l)) = self.boxes.get_mut(id as usize).and_then(Option::take) else {
             return;
         };
         self.len -= 1;
-        let (lo, hi) = cell_range(&b, self.inv);
-        if cell_count(&lo, &hi) > MAX_CELLS_PER_FACE {
+        let l = l as usize;
+        if l >= self.cells.len() {
             self.big.retain(|&x| x != id);
             return;
         }
-        let cells = &mut self.cells;
-        for_cells(lo, hi, |c| {
-            if let Some(v) = cells.get_mut(&key(c)) {
-                v.retain(|&x| x != id);
-                if v.is_empty() {
-                    cells.remove(&key(c));
+        self.members[l].retain(|&x| x != id);
+        let (lo, hi, _) = hash_range(&b, self.inv(l));
+        let cells = &mut self.cells[l];
+        for x in lo[0]..=hi[0] {
+            for y in lo[1]..=hi[1] {
+                for z in lo[2]..=hi[2] {
+                    let k = hash_key([x, y, z]);
+                    if let Some(v) = cells.get_mut(&k) {
+                        v.retain(|&x| x != id);
+                        if v.is_empty() {
+                            cells.remove(&k);
+                        }
+                    }
                 }
             }
-        });
+        }
     }
 
     /// The ids of the inserted faces whose boxes overlap `b`, ascending and without
@@ -362,23 +611,30 @@ impl FaceGrid {
         if !b.is_finite() {
             return;
         }
-        let (lo, hi) = cell_range(b, self.inv);
-        if cell_count(&lo, &hi) > MAX_CELLS_PER_FACE {
-            // A large query box: scanning every face is cheaper than every cell.
-            out.extend(
-                self.boxes
-                    .iter()
-                    .enumerate()
-                    .filter(|(_, o)| o.is_some_and(|o| o.overlaps(b)))
-                    .map(|(i, _)| i as u32),
-            );
-            return;
-        }
-        for_cells(lo, hi, |c| {
-            if let Some(v) = self.cells.get(&key(c)) {
-                out.extend(v.iter().copied().filter(|&i| self.overlaps(i, b)));
+        for l in 0..self.cells.len() {
+            if self.members[l].is_empty() {
+                continue;
             }
-        });
+            let (lo, hi, n) = hash_range(b, self.inv(l));
+            if n > MAX_QUERY_CELLS || n > self.members[l].len() as u64 {
+                out.extend(
+                    self.members[l]
+                        .iter()
+                        .copied()
+                        .filter(|&i| self.overlaps(i, b)),
+                );
+                continue;
+            }
+            for x in lo[0]..=hi[0] {
+                for y in lo[1]..=hi[1] {
+                    for z in lo[2]..=hi[2] {
+                        if let Some(v) = self.cells[l].get(&hash_key([x, y, z])) {
+                            out.extend(v.iter().copied().filter(|&i| self.overlaps(i, b)));
+                        }
+                    }
+                }
+            }
+        }
         out.extend(self.big.iter().copied().filter(|&i| self.overlaps(i, b)));
         out.sort_unstable();
         out.dedup();
@@ -394,7 +650,7 @@ impl FaceGrid {
             .get(i as usize)
             .copied()
             .flatten()
-            .is_some_and(|o| o.overlaps(b))
+            .is_some_and(|(o, _)| o.overlaps(b))
     }
 }
 
@@ -407,7 +663,12 @@ mod tests {
         let mut boxes: Vec<Aabb> = (0..n)
             .map(|i| {
                 let c = rng.in_cube(1.0);
-                let s = if i < outliers { 1.5 } else { 0.05 };
+                // The first `outliers` boxes spread over three orders of magnitude.
+                let s = if i < outliers {
+                    10f64.powf(rng.uniform(-3.0, 0.3))
+                } else {
+                    0.05
+                };
                 let t: Tri = [0, 1, 2].map(|_| {
                     let d = rng.in_cube(s);
                     [c[0] + d[0], c[1] + d[1], c[2] + d[2]]
@@ -443,7 +704,7 @@ mod tests {
     #[test]
     fn pair_grid_finds_every_overlapping_pair_once() {
         let mut rng = XorShift64::new(3);
-        for (n, outliers) in [(0, 0), (1, 0), (50, 0), (400, 5), (400, 40)] {
+        for (n, outliers) in [(0, 0), (1, 0), (50, 0), (400, 5), (400, 40), (400, 200)] {
             let boxes = random_boxes(&mut rng, n, outliers);
             for cell in [cell_size(&boxes), 1e-3, 0.3, 10.0, f64::NAN, 0.0] {
                 let grid = PairGrid::new(&boxes, cell);
@@ -476,7 +737,15 @@ mod tests {
             grid.insert(i as u32, *b);
         }
         assert_eq!(grid.len(), boxes.len() - 1); // the NaN box is not kept
-                                                 // Remove every other face; queries see only the rest.
+        assert!(!grid.is_empty());
+        let t: Tri = [[0.0; 3], [0.1, 0.0, 0.0], [0.0, 0.1, 0.0]];
+        grid.query_triangle(&t, &mut out);
+        let b = Aabb::of_triangle(&t);
+        let expected: Vec<u32> = (0..boxes.len() as u32)
+            .filter(|&j| boxes[j as usize].overlaps(&b))
+            .collect();
+        assert_eq!(out, expected);
+        // Remove every other face; queries see only the rest.
         for i in (0..boxes.len() as u32).step_by(2) {
             grid.remove(i);
         }

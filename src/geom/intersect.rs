@@ -26,6 +26,7 @@ pub(crate) type Tri = [P3; 3];
 ///
 /// Degenerate triangles are the segment or point they cover. Any non-finite coordinate
 /// answers `false` (such a triangle is not a point set; mesh validation reports it apart).
+#[cfg_attr(not(test), allow(dead_code))] // for the mesher's checks; tested here
 pub(crate) fn triangles_intersect(a: Tri, b: Tri) -> bool {
     if !finite(&a) || !finite(&b) {
         return false;
@@ -49,6 +50,7 @@ pub(crate) fn triangles_intersect(a: Tri, b: Tri) -> bool {
 /// with the other face answers `false`: it has no interior to overlap with, and validation
 /// reports it as degenerate. Sharing none, it is tested as the point set it covers.
 /// An index out of range or a non-finite corner answers `false` (also reported apart).
+#[cfg_attr(not(test), allow(dead_code))] // for the mesher's checks; tested here
 pub(crate) fn faces_intersect(p: &[P3], f: [u32; 3], g: [u32; 3]) -> bool {
     let corners = |t: [u32; 3]| -> Option<Tri> {
         let c = [
@@ -80,24 +82,59 @@ pub(crate) fn faces_intersect(p: &[P3], f: [u32; 3], g: [u32; 3]) -> bool {
 /// [`faces_intersect`] for faces known to have three distinct in-range indices and
 /// non-degenerate, finite corners (what validation tests after filtering), with the
 /// predicates `o` (which must be exact on `p`).
+#[cfg_attr(not(test), allow(dead_code))] // for the mesher's checks; tested here
 pub(crate) fn proper_faces_intersect<O: Orient>(o: O, p: &[P3], f: [u32; 3], g: [u32; 3]) -> bool {
-    let at = |i: u32| p[i as usize];
-    let in_g = f.map(|v| g.contains(&v));
-    match in_g.iter().filter(|&&s| s).count() {
-        0 => tri_tri(o, &f.map(at), &g.map(at)),
+    let at = |t: [u32; 3]| [p[t[0] as usize], p[t[1] as usize], p[t[2] as usize]];
+    proper_corners_intersect(o, f, &at(f), g, &at(g))
+}
+
+/// [`proper_faces_intersect`] with the corners `tf`, `tg` of faces `f`, `g` at hand.
+#[inline]
+pub(crate) fn proper_corners_intersect<O: Orient>(
+    o: O,
+    f: [u32; 3],
+    tf: &Tri,
+    g: [u32; 3],
+    tg: &Tri,
+) -> bool {
+    let in_g = [g.contains(&f[0]), g.contains(&f[1]), g.contains(&f[2])];
+    match in_g[0] as u8 + in_g[1] as u8 + in_g[2] as u8 {
+        0 => tri_tri(o, tf, tg),
         1 => {
             // Rotate both so that the shared vertex comes first.
-            let i = in_g.iter().position(|&s| s).unwrap_or(0);
-            let j = g.iter().position(|&v| v == f[i]).unwrap_or(0);
-            let (v, b, c) = (at(f[i]), at(f[(i + 1) % 3]), at(f[(i + 2) % 3]));
-            let (d, e) = (at(g[(j + 1) % 3]), at(g[(j + 2) % 3]));
-            wedges_meet(o, v, b, c, d, e)
+            let i = if in_g[0] {
+                0
+            } else if in_g[1] {
+                1
+            } else {
+                2
+            };
+            let j = if g[0] == f[i] {
+                0
+            } else if g[1] == f[i] {
+                1
+            } else {
+                2
+            };
+            let (v, b, c) = (tf[i], tf[(i + 1) % 3], tf[(i + 2) % 3]);
+            wedges_meet(o, v, b, c, tg[(j + 1) % 3], tg[(j + 2) % 3])
         }
         2 => {
-            let i = in_g.iter().position(|&s| !s).unwrap_or(0);
-            let d = g.iter().copied().find(|v| !f.contains(v)).unwrap_or(g[0]);
-            let (a, b, c) = (at(f[(i + 1) % 3]), at(f[(i + 2) % 3]), at(f[i]));
-            folded_onto(o, a, b, c, at(d))
+            let i = if !in_g[0] {
+                0
+            } else if !in_g[1] {
+                1
+            } else {
+                2
+            };
+            let j = if !f.contains(&g[0]) {
+                0
+            } else if !f.contains(&g[1]) {
+                1
+            } else {
+                2
+            };
+            folded_onto(o, tf[(i + 1) % 3], tf[(i + 2) % 3], tf[i], tg[j])
         }
         _ => true,
     }
@@ -105,6 +142,7 @@ pub(crate) fn proper_faces_intersect<O: Orient>(o: O, p: &[P3], f: [u32; 3], g: 
 
 /// Whether `a, b, c` are collinear or coincident (decided exactly; non-finite input counts as
 /// degenerate). A triangle with this property has no plane and no interior.
+#[cfg_attr(not(test), allow(dead_code))] // for the mesher's checks; tested here
 pub(crate) fn triangle_is_degenerate(t: Tri) -> bool {
     !finite(&t) || drop_axis(Checked, t[0], t[1], t[2]).is_none()
 }
@@ -138,12 +176,22 @@ fn proj(p: P3, k: usize) -> [f64; 2] {
 /// they all vanish exactly then). The float normal's largest component is tried first, so
 /// one exact `orient2d` usually decides.
 fn drop_axis<O: Orient>(o: O, a: P3, b: P3, c: P3) -> Option<usize> {
-    let n = cross(sub(b, a), sub(c, a)).map(f64::abs);
-    let mut order = [0, 1, 2];
-    order.sort_by(|&i, &j| n[j].total_cmp(&n[i]));
-    order
+    let n = cross(sub(b, a), sub(c, a));
+    let (x, y, z) = (n[0].abs(), n[1].abs(), n[2].abs());
+    let first = if x >= y && x >= z {
+        0
+    } else if y >= z {
+        1
+    } else {
+        2
+    };
+    let area = |k: usize| o.orient2d(proj(a, k), proj(b, k), proj(c, k));
+    if area(first) != 0 {
+        return Some(first);
+    }
+    [(first + 1) % 3, (first + 2) % 3]
         .into_iter()
-        .find(|&k| o.orient2d(proj(a, k), proj(b, k), proj(c, k)) != 0)
+        .find(|&k| area(k) != 0)
 }
 
 /// The point set a triangle covers.
@@ -286,11 +334,13 @@ fn segment_meets_triangle<O: Orient>(
 
 /// Two non-degenerate closed triangles.
 fn tri_tri<O: Orient>(o: O, a: &Tri, b: &Tri) -> bool {
-    let sa = a.map(|p| o.orient3d(b[0], b[1], b[2], p));
+    let pb = o.plane(b[0], b[1], b[2]);
+    let sa = [o.side(&pb, a[0]), o.side(&pb, a[1]), o.side(&pb, a[2])];
     if one_side(sa) {
         return false;
     }
-    let sb = b.map(|p| o.orient3d(a[0], a[1], a[2], p));
+    let pa = o.plane(a[0], a[1], a[2]);
+    let sb = [o.side(&pa, b[0]), o.side(&pa, b[1]), o.side(&pa, b[2])];
     if one_side(sb) {
         return false;
     }
@@ -336,8 +386,8 @@ fn tri_tri<O: Orient>(o: O, a: &Tri, b: &Tri) -> bool {
 /// point. Coplanar, two wedges of angle < π share a direction iff one holds a boundary ray
 /// of the other.
 fn wedges_meet<O: Orient>(o: O, v: P3, b: P3, c: P3, d: P3, e: P3) -> bool {
-    let sb = o.orient3d(v, d, e, b);
-    let sc = o.orient3d(v, d, e, c);
+    let g = o.plane(v, d, e);
+    let (sb, sc) = (o.side(&g, b), o.side(&g, c));
     if sb * sc > 0 {
         return false;
     }
@@ -378,6 +428,7 @@ fn folded_onto<O: Orient>(o: O, a: P3, b: P3, c: P3, d: P3) -> bool {
 mod tests {
     use super::*;
     use crate::audit::XorShift64;
+    use crate::geom::predicates::InRange;
 
     fn tri(a: [f64; 3], b: [f64; 3], c: [f64; 3]) -> Tri {
         [a, b, c]
@@ -799,6 +850,10 @@ mod tests {
             }
             let expected = lp_reference(&a, &b);
             assert_eq!(triangles_intersect(a, b), expected, "{a:?} {b:?}");
+            // Validation's path: robust directly, with the filtered plane sides.
+            if !triangle_is_degenerate(a) && !triangle_is_degenerate(b) {
+                assert_eq!(tri_tri(InRange, &a, &b), expected, "{a:?} {b:?}");
+            }
             hits += expected as usize;
             total += 1;
         }
@@ -847,6 +902,7 @@ mod tests {
             };
             let got = faces_intersect(&p, f, g);
             assert_eq!(got, expected, "{f:?} {g:?} {p:?}");
+            assert_eq!(proper_faces_intersect(InRange, &p, f, g), expected);
             checked += 1;
             hits += got as usize;
         }

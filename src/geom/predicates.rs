@@ -20,9 +20,15 @@ const FAST_LOW: i32 = -300;
 
 /// Orientation predicates, exact on the inputs the implementation accepts.
 pub(crate) trait Orient: Copy {
+    /// What [`Orient::side`] needs of a plane, computed once for several points.
+    type Plane: Copy;
     /// Sign of `det[b − a, c − a, d − a]`: positive when `d` lies on the side of the plane
     /// `abc` that `(b − a) × (c − a)` points to.
     fn orient3d(self, a: P3, b: P3, c: P3, d: P3) -> i8;
+    /// The plane through `a, b, c`, for [`Orient::side`].
+    fn plane(self, a: P3, b: P3, c: P3) -> Self::Plane;
+    /// `orient3d(a, b, c, d)` for the plane of [`Orient::plane`]`(a, b, c)`.
+    fn side(self, plane: &Self::Plane, d: P3) -> i8;
     /// Sign of `(b − a) × (c − a)`: positive when `a, b, c` turn counter-clockwise.
     fn orient2d(self, a: [f64; 2], b: [f64; 2], c: [f64; 2]) -> i8;
 }
@@ -62,11 +68,62 @@ fn c2(p: [f64; 2]) -> Coord<f64> {
     Coord { x: p[0], y: p[1] }
 }
 
+/// Shewchuk's first error bound of orient3d, `(7 + 56ε)ε` with `ε = 2⁻⁵³`.
+const O3D_ERRBOUND_A: f64 = (7.0 + 56.0 * f64::EPSILON / 2.0) * f64::EPSILON / 2.0;
+
+/// A plane for [`InRange::side`]: its corners, and the normal `n = (b − a) × (c − a)` with
+/// the absolute values of its products, as orient3d's first stage computes them.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct FilteredPlane {
+    corners: [P3; 3],
+    n: P3,
+    magnitude: P3,
+}
+
 impl Orient for InRange {
+    type Plane = FilteredPlane;
     #[inline]
     fn orient3d(self, a: P3, b: P3, c: P3, d: P3) -> i8 {
         // robust's orient3d is det[a − d, b − d, c − d] = −det[b − a, c − a, d − a].
         -sign(robust::orient3d(c3(a), c3(b), c3(c), c3(d)))
+    }
+    #[inline]
+    fn plane(self, a: P3, b: P3, c: P3) -> FilteredPlane {
+        let u = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
+        let w = [c[0] - a[0], c[1] - a[1], c[2] - a[2]];
+        let (yz, zy) = (u[1] * w[2], u[2] * w[1]);
+        let (zx, xz) = (u[2] * w[0], u[0] * w[2]);
+        let (xy, yx) = (u[0] * w[1], u[1] * w[0]);
+        FilteredPlane {
+            corners: [a, b, c],
+            n: [yz - zy, zx - xz, xy - yx],
+            magnitude: [
+                yz.abs() + zy.abs(),
+                zx.abs() + xz.abs(),
+                xy.abs() + yx.abs(),
+            ],
+        }
+    }
+    /// `det[b − a, c − a, d − a] = (d − a) · n`, evaluated exactly as orient3d's first stage
+    /// evaluates the transposed determinant (each entry one rounded difference, the same
+    /// expression tree), so the same error bound `O3D_ERRBOUND_A · permanent` holds; only
+    /// when it does not decide the sign does `robust` run in full.
+    #[inline]
+    fn side(self, pl: &FilteredPlane, d: P3) -> i8 {
+        let a = pl.corners[0];
+        let x = [d[0] - a[0], d[1] - a[1], d[2] - a[2]];
+        let det = x[0] * pl.n[0] + x[1] * pl.n[1] + x[2] * pl.n[2];
+        let permanent = pl.magnitude[0] * x[0].abs()
+            + pl.magnitude[1] * x[1].abs()
+            + pl.magnitude[2] * x[2].abs();
+        let bound = O3D_ERRBOUND_A * permanent;
+        if det > bound {
+            1
+        } else if -det > bound {
+            -1
+        } else {
+            self.orient3d(a, pl.corners[1], pl.corners[2], d)
+        }
     }
     #[inline]
     fn orient2d(self, a: [f64; 2], b: [f64; 2], c: [f64; 2]) -> i8 {
@@ -75,6 +132,13 @@ impl Orient for InRange {
 }
 
 impl Orient for Checked {
+    type Plane = [P3; 3];
+    fn plane(self, a: P3, b: P3, c: P3) -> [P3; 3] {
+        [a, b, c]
+    }
+    fn side(self, pl: &[P3; 3], d: P3) -> i8 {
+        self.orient3d(pl[0], pl[1], pl[2], d)
+    }
     fn orient3d(self, a: P3, b: P3, c: P3, d: P3) -> i8 {
         let e = Exponents::of(a.iter().chain(&b).chain(&c).chain(&d).copied());
         match e.plan() {
@@ -426,6 +490,35 @@ mod tests {
         assert_eq!(scale(3.0, 2000), 3.0 * 2f64.powi(1000) * 2f64.powi(1000));
     }
 
+    /// The filtered side test agrees with the exact orientation, also where the filter
+    /// cannot decide (points on and an ulp off the plane).
+    #[test]
+    fn the_plane_filter_agrees_with_orient3d() {
+        let mut rng = XorShift64::new(17);
+        let mut undecided = 0;
+        for i in 0..20_000 {
+            let (a, b, c) = (rng.in_cube(1.0), rng.in_cube(1.0), rng.in_cube(1.0));
+            let mut d = rng.in_cube(1.0);
+            if i % 2 == 0 {
+                // A point of the plane z = a.z, or one ulp off it.
+                let (a, b, c) = ([a[0], a[1], 0.5], [b[0], b[1], 0.5], [c[0], c[1], 0.5]);
+                let z = f64::from_bits(0.5f64.to_bits() + (i as u64 % 3)).min(0.5000001);
+                d[2] = if i % 4 == 0 { z } else { -z + 1.0 };
+                let pl = InRange.plane(a, b, c);
+                assert_eq!(InRange.side(&pl, d), exact::orient3d(a, b, c, d));
+                undecided += (InRange.side(&pl, d) == 0) as usize;
+                continue;
+            }
+            let pl = InRange.plane(a, b, c);
+            assert_eq!(InRange.side(&pl, d), exact::orient3d(a, b, c, d));
+            assert_eq!(
+                Checked.side(&Checked.plane(a, b, c), d),
+                exact::orient3d(a, b, c, d)
+            );
+        }
+        assert!(undecided > 1000, "{undecided}");
+    }
+
     /// The three evaluations (robust, robust after scaling, integers) agree on random and on
     /// exactly coplanar input, and the integer path decides spreads robust cannot.
     #[test]
@@ -444,7 +537,7 @@ mod tests {
             }
             let fast = InRange.orient3d(p[0], p[1], p[2], p[3]);
             assert_eq!(fast, exact::orient3d(p[0], p[1], p[2], p[3]));
-            let k = 700 - (i as i32 % 1400);
+            let k = 700 - (i % 1400);
             let s = |q: P3| q.map(|x| scale(x, k));
             assert_eq!(fast, Checked.orient3d(s(p[0]), s(p[1]), s(p[2]), s(p[3])));
             let q = |v: P3| [v[0], v[1]];

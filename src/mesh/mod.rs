@@ -1,6 +1,12 @@
 //! The finished mesh: what every stage after triangulation reads, and what the samples' provenance is recorded in.
+//!
+//! [`Mesh::validate`] checks any mesh for validity (manifold, oriented, non-degenerate,
+//! embedded) with exact predicates and reports what it found as a [`Validation`].
 
 use serde::{Deserialize, Serialize};
+
+mod validate;
+pub use validate::{Offenders, Validation, MAX_EXAMPLES};
 
 /// Where a vertex came from in the sampling stage.
 ///
