@@ -80,6 +80,12 @@ pub enum MeshError {
     /// The previous method needs at least three curves to span the tangent plane.
     #[error("the previous method needs at least 3 curves (got {0}); use --curves 3 or more")]
     TooFewCurves(usize),
+    /// The finished mesh failed validation (a bug: please report the input).
+    #[error(
+        "the mesh failed validation: {0}; this is a bug in liemesh, please report the input \
+         (a mesh that fails validation is never returned)"
+    )]
+    Invalid(Box<crate::mesh::Validation>),
     /// The samples could not be triangulated (too few points, all points collinear in the chart…).
     #[error("could not triangulate the samples: {0}")]
     Triangulation(String),

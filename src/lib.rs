@@ -68,6 +68,12 @@ pub struct MeshRun<T> {
     pub vertices: Vec<scalar::Vec3<T>>,
     /// What refinement to [`MeshParams::max_normal_error`] did, if it was asked for.
     pub refinement: Option<triangulate::Refinement>,
+    /// What stitching where fronts met did.
+    pub stitched: triangulate::Stitched,
+    /// What was undone so that the mesh does not cross itself.
+    pub untangled: triangulate::Untangled,
+    /// The mesh's validation (always valid: an invalid mesh is an error).
+    pub validation: mesh::Validation,
     /// How long each stage took.
     pub timings: Timings,
 }
@@ -83,6 +89,8 @@ pub struct Timings {
     pub improving: f64,
     /// Refinement to a normal-error bound.
     pub refining: f64,
+    /// Validation, and undoing crossings if there were any.
+    pub validating: f64,
 }
 
 /// Samples and triangulates the surface of `field` (the whole pipeline), keeping the
@@ -116,11 +124,20 @@ pub fn run<T: Scalar, F: NormalField<T>>(
                 .clone()
         })
         .collect();
-    if params.terminal.close {
-        triangulate::stitch(field, params, &samples, &mut mesh, &mut vertices);
-    }
+    let stitched = params
+        .terminal
+        .close
+        .then(|| triangulate::stitch(field, params, &samples, &mut mesh, &mut vertices))
+        .unwrap_or_default();
     lap(&mut timings.triangulating, &mut since);
-    if improve && std::env::var("NORELAX").is_err() {
+    // Where every vertex was before relaxation: a relaxation move that makes faces cross is
+    // taken back.
+    let before = improve.then(|| triangulate::Before {
+        positions: mesh.vertices.clone(),
+        normals: mesh.normals.clone(),
+        working: vertices.clone(),
+    });
+    if improve {
         triangulate::relax(field, params, &mut mesh, &mut vertices);
     }
     lap(&mut timings.improving, &mut since);
@@ -128,12 +145,30 @@ pub fn run<T: Scalar, F: NormalField<T>>(
         triangulate::refine(field, params, limit.to_degrees(), &mut mesh, &mut vertices)
     });
     lap(&mut timings.refining, &mut since);
+    // Validation, decided exactly; crossings are undone (see `triangulate::untangle`).
+    triangulate::keep_main_component(&mut mesh);
+    let mut validation = mesh.validate();
+    let mut untangled = triangulate::Untangled::default();
+    if !validation.self_intersections.is_empty() {
+        untangled = triangulate::untangle(&mut mesh, &mut vertices, before.as_ref(), |p, t| {
+            mesh::crossings(p, t)
+        });
+        validation = mesh.validate();
+    }
+    triangulate::drop_unused(&mut mesh, &mut vertices);
+    lap(&mut timings.validating, &mut since);
+    if !validation.is_valid() {
+        return Err(MeshError::Invalid(Box::new(validation)));
+    }
     Ok(MeshRun {
         samples,
         chart,
         mesh,
         vertices,
         refinement,
+        stitched,
+        untangled,
+        validation,
         timings,
     })
 }

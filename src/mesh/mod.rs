@@ -8,6 +8,11 @@ use serde::{Deserialize, Serialize};
 mod validate;
 pub use validate::{Offenders, Validation, MAX_EXAMPLES};
 
+/// Every self-intersecting pair of faces (lower index first, in order), decided exactly.
+pub(crate) fn crossings(p: &[[f64; 3]], tris: &[[u32; 3]]) -> Vec<(usize, usize)> {
+    validate::validate_listing_crossings(p, tris).1
+}
+
 /// Where a vertex came from in the sampling stage.
 ///
 /// `curve` and `step` identify the integral curve and the accepted step on it

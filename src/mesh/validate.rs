@@ -302,6 +302,14 @@ fn insertion_sort(v: &mut [u64]) {
 /// vertex fans and the broad phase fast (both are bound by memory access, not arithmetic);
 /// offenders are translated back to the caller's numbers.
 pub(crate) fn validate(p: &[P3], tris: &[[u32; 3]]) -> Validation {
+    validate_listing_crossings(p, tris).0
+}
+
+/// [`validate`], and every self-intersecting pair of faces (lower index first, in order).
+pub(crate) fn validate_listing_crossings(
+    p: &[P3],
+    tris: &[[u32; 3]],
+) -> (Validation, Vec<(usize, usize)>) {
     let n = p.len();
     let mut v = Validation {
         vertices: 0,
@@ -397,11 +405,18 @@ pub(crate) fn validate(p: &[P3], tris: &[[u32; 3]]) -> Validation {
     for k in degenerate {
         v.degenerate_faces.push(old_face[k as usize] as usize);
     }
-    for (a, b) in crossings {
-        let (f, g) = (old_face[a as usize] as usize, old_face[b as usize] as usize);
-        v.self_intersections.push((f.min(g), f.max(g)));
+    let mut all: Vec<(usize, usize)> = crossings
+        .into_iter()
+        .map(|(a, b)| {
+            let (f, g) = (old_face[a as usize] as usize, old_face[b as usize] as usize);
+            (f.min(g), f.max(g))
+        })
+        .collect();
+    for &pair in &all {
+        v.self_intersections.push(pair);
     }
-    v
+    all.sort_unstable();
+    (v, all)
 }
 
 /// Counts, edges, fans, components and boundary loops of `faces` (all proper, over `n`

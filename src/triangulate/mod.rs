@@ -26,6 +26,9 @@ mod reopen;
 pub(crate) use refine::refine;
 pub use refine::{Refinement, MAX_REFINE_ROUNDS};
 pub(crate) use relax::relax;
+pub use stitch::Stitched;
+pub(crate) use untangle::{drop_unused, keep_main_component, untangle, Before};
+pub use untangle::{Untangled, UNTANGLE_ROUNDS};
 
 #[cfg(test)]
 pub(crate) use crate::mesh::octahedron;
@@ -135,8 +138,6 @@ pub fn triangulate<T: Scalar>(
 /// 1e-16 on the model's integrable fields; a rotation of 0.001 rad leaves 1e-3).
 const INTEGRABLE_DEFECT: f64 = 1e-9;
 
-/// What [`stitch`] did: see [`stitch::stitch`].
-pub(crate) use stitch::Stitched;
 
 /// Stitches the chart mesh where its fronts meet (see the `stitch` module): triangles
 /// between boundary parts that face each other and, on an integrable field, new vertices on

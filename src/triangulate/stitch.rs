@@ -62,17 +62,20 @@ pub(crate) const MIN_ANGLE_DEG: f64 = 12.0;
 /// degrees.
 pub(crate) const MAX_TILT_DEG: f64 = 60.0;
 
-/// What stitching did.
+/// What stitching where fronts met did.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub(crate) struct Stitched {
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[non_exhaustive]
+pub struct Stitched {
     /// Triangles added.
-    pub(crate) added: usize,
+    pub added: usize,
     /// Vertices added (on the surface, where a gap or hole had none to connect).
-    pub(crate) vertices: usize,
-    /// Triangles removed to cut pinched vertices apart.
-    pub(crate) removed: usize,
+    pub vertices: usize,
+    /// Triangles removed: around holes that were opened and stitched again, and to cut
+    /// pinched vertices apart.
+    pub removed: usize,
     /// Whether the operation budget ran out before no candidate was left.
-    pub(crate) budget_hit: bool,
+    pub budget_hit: bool,
 }
 
 type EdgeMap<V> = HashMap<(u32, u32), V, FastHash>;
