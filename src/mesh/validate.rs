@@ -4,8 +4,14 @@
 //! The topology is read from the faces around each vertex (a vertex → faces table built by
 //! counting sort, then each vertex's edges sorted by their far end): no hash table, and the
 //! same walk gives the edges, their use counts and directions, and the fans at each vertex.
-//! Self-intersections are found by a grid broad phase over the faces' boxes and decided by
-//! [`proper_faces_intersect`](crate::geom::intersect::proper_faces_intersect).
+//! Self-intersections are found by a grid broad phase over the faces' boxes
+//! ([`PairGrid`]) and decided exactly by
+//! [`proper_faces_intersect`](crate::geom::intersect::proper_faces_intersect)'s rules.
+//!
+//! Both walks are bound by memory access, so they read the mesh renumbered in space-filling
+//! order (see [`validate`]). On large meshes the topology and the geometry run side by
+//! side and the pair tests run by chunks of cells on rayon's pool; every result is either a
+//! count or the lowest offenders, so the report is the same for any number of threads.
 
 use super::Mesh;
 use crate::geom::grid::{cell_size, radix_sort, spatial_order, Aabb, PairGrid};
