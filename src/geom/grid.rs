@@ -298,32 +298,78 @@ impl<'a> PairGrid<'a> {
             }
             h *= 2.0;
         };
-        let mut filed: Vec<u64> = Vec::with_capacity(4 * boxes.len());
-        for (i, b) in boxes.iter().enumerate() {
-            let l = level[i] as usize;
-            if l >= levels.len() {
+        // Cells of the coarser levels that hold faces of their own: guests are filed only
+        // there (elsewhere they would meet nobody). A bitset per level, when it is small.
+        let mut occupied: Vec<Option<Vec<u64>>> = levels
+            .iter()
+            .map(|l| (l.size() <= 1 << 24).then(|| vec![0u64; (l.size() as usize).div_ceil(64)]))
+            .collect();
+        for (b, &l) in boxes.iter().zip(&level) {
+            let l = l as usize;
+            if l == 0 || l >= levels.len() {
                 continue;
             }
-            // At its own level, and as a guest at every coarser occupied level.
-            for (lv, lev) in levels.iter().enumerate().skip(l) {
-                if lv > l && !used[lv] {
-                    continue;
-                }
-                let id = ((lv > l) as u64) << guest_bit | (i as u64) << FLAG_BITS;
+            if let Some(bits) = occupied[l].as_mut() {
+                let lev = &levels[l];
                 let (lo, hi) = (lev.cell(&b.min), lev.cell(&b.max));
                 for x in lo[0]..=hi[0] {
                     for y in lo[1]..=hi[1] {
                         for z in lo[2]..=hi[2] {
-                            let low = (x == lo[0]) as u64
-                                | ((y == lo[1]) as u64) << 1
-                                | ((z == lo[2]) as u64) << 2;
-                            let key = lev.offset + morton([x, y, z]);
-                            filed.push(key << tag_bits | id | low);
+                            let k = morton([x, y, z]);
+                            bits[(k / 64) as usize] |= 1 << (k % 64);
                         }
                     }
                 }
             }
         }
+        let has_natives = |lv: usize, key: u64| {
+            occupied[lv]
+                .as_ref()
+                .is_none_or(|bits| bits[(key / 64) as usize] >> (key % 64) & 1 == 1)
+        };
+        // Entries by chunks of faces (in parallel on large meshes), concatenated in face
+        // order: the same entries in the same order for any number of threads.
+        let file = |range: Range<usize>| {
+            let mut filed: Vec<u64> = Vec::with_capacity(4 * range.len());
+            for i in range {
+                let (b, l) = (&boxes[i], level[i] as usize);
+                if l >= levels.len() {
+                    continue;
+                }
+                // At its own level, and as a guest at every coarser occupied level.
+                for (lv, lev) in levels.iter().enumerate().skip(l) {
+                    if lv > l && !used[lv] {
+                        continue;
+                    }
+                    let guest = lv > l;
+                    let id = (guest as u64) << guest_bit | (i as u64) << FLAG_BITS;
+                    let (lo, hi) = (lev.cell(&b.min), lev.cell(&b.max));
+                    for x in lo[0]..=hi[0] {
+                        let (mx, fx) = (spread3(x as u64) << 2, (x == lo[0]) as u64);
+                        for y in lo[1]..=hi[1] {
+                            let my = mx + (spread3(y as u64) << 1);
+                            let fy = fx | ((y == lo[1]) as u64) << 1;
+                            for z in lo[2]..=hi[2] {
+                                let code = my + spread3(z as u64);
+                                if guest && !has_natives(lv, code) {
+                                    continue;
+                                }
+                                let low = fy | ((z == lo[2]) as u64) << 2;
+                                filed.push((lev.offset + code) << tag_bits | id | low);
+                            }
+                        }
+                    }
+                }
+            }
+            filed
+        };
+        let n = boxes.len();
+        let chunks = if n >= crate::par::MIN_CHEAP { 16 } else { 1 };
+        let mut filed = if chunks == 1 {
+            file(0..n)
+        } else {
+            crate::par::map(chunks, 2, |c| file(c * n / chunks..(c + 1) * n / chunks)).concat()
+        };
         let key_bits = levels
             .last()
             .map_or(0, |l| 64 - (l.offset + l.size() - 1).leading_zeros());
@@ -406,7 +452,7 @@ impl<'a> PairGrid<'a> {
 
 /// `0..n` in the Morton order of the points `at(i)` (non-finite points last), so that items
 /// near in space can be stored near in memory. `at` is called twice per item.
-pub(crate) fn spatial_order(n: usize, at: impl Fn(usize) -> P3) -> Vec<u32> {
+pub(crate) fn spatial_order(n: usize, at: impl Fn(usize) -> P3 + Sync) -> Vec<u32> {
     let (mut gmin, mut gmax) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
     let finite = |c: &P3| c.iter().all(|x| x.is_finite());
     for i in 0..n {
@@ -426,17 +472,15 @@ pub(crate) fn spatial_order(n: usize, at: impl Fn(usize) -> P3) -> Vec<u32> {
     let side = (0..3).map(|k| gmax[k] - gmin[k]).fold(0.0, f64::max) / 1023.0;
     let level = Level::new(base_cell(side), &gmin, &gmax, 0);
     let id_bits = 64 - (n as u64).leading_zeros();
-    let mut keyed: Vec<u64> = (0..n)
-        .map(|i| {
-            let c = at(i);
-            let key = if finite(&c) {
-                morton(level.cell(&c))
-            } else {
-                level.size()
-            };
-            key << id_bits | i as u64
-        })
-        .collect();
+    let mut keyed: Vec<u64> = crate::par::map(n, crate::par::MIN_CHEAP, |i| {
+        let c = at(i);
+        let key = if finite(&c) {
+            morton(level.cell(&c))
+        } else {
+            level.size()
+        };
+        key << id_bits | i as u64
+    });
     let key_bits = 64 - level.size().leading_zeros();
     radix_sort(&mut keyed, id_bits, id_bits + key_bits);
     keyed

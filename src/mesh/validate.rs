@@ -4,8 +4,14 @@
 //! The topology is read from the faces around each vertex (a vertex → faces table built by
 //! counting sort, then each vertex's edges sorted by their far end): no hash table, and the
 //! same walk gives the edges, their use counts and directions, and the fans at each vertex.
-//! Self-intersections are found by a grid broad phase over the faces' boxes and decided by
-//! [`proper_faces_intersect`](crate::geom::intersect::proper_faces_intersect).
+//! Self-intersections are found by a grid broad phase over the faces' boxes
+//! ([`PairGrid`]) and decided exactly by
+//! [`proper_faces_intersect`](crate::geom::intersect::proper_faces_intersect)'s rules.
+//!
+//! Both walks are bound by memory access, so they read the mesh renumbered in space-filling
+//! order (see [`validate`]). On large meshes the topology and the geometry run side by
+//! side and the pair tests run by chunks of cells on rayon's pool; every result is either a
+//! count or the lowest offenders, so the report is the same for any number of threads.
 
 use super::Mesh;
 use crate::geom::grid::{cell_size, radix_sort, spatial_order, Aabb, PairGrid};
@@ -337,7 +343,7 @@ pub(crate) fn validate_listing_crossings(
     for (new, &old) in old_vertex.iter().enumerate() {
         rank[old as usize] = new as u32;
     }
-    let q: Vec<P3> = old_vertex.iter().map(|&old| p[old as usize]).collect();
+    let q: Vec<P3> = par::map(n, par::MIN_CHEAP, |k| p[old_vertex[k] as usize]);
     // Faces with three distinct in-range indices take part in the topology; renumbered, and
     // sorted by lowest vertex (`old_face[new]`).
     let id_bits = 64 - (tris.len() as u64).leading_zeros();
@@ -359,10 +365,9 @@ pub(crate) fn validate_listing_crossings(
     let ids = (1u64 << id_bits) - 1;
     let old_face: Vec<u32> = keyed.iter().map(|&e| (e & ids) as u32).collect();
     drop(keyed);
-    let faces: Vec<[u32; 3]> = old_face
-        .iter()
-        .map(|&f| tris[f as usize].map(|i| rank[i as usize]))
-        .collect();
+    let faces: Vec<[u32; 3]> = par::map(old_face.len(), par::MIN_CHEAP, |k| {
+        tris[old_face[k] as usize].map(|i| rank[i as usize])
+    });
     drop(rank);
     // Topology and geometry read the same arrays and write apart: on large meshes they run
     // side by side.
@@ -722,32 +727,40 @@ mod tests {
         v
     }
 
-    /// A random triangle soup: corners from a pool (so faces share vertices), some on a
-    /// coarse integer lattice (so that coincident, collinear and coplanar corners occur),
-    /// sizes spread over three orders of magnitude (so that the grid needs several levels).
+    /// A random triangle soup: clusters of five corners with sizes over two and a half
+    /// orders of magnitude (so that the grid needs several levels), nine faces in ten within
+    /// a cluster (sharing corners), one in ten across the whole soup; on a lattice of 1/64
+    /// if asked (so that coincident, collinear and coplanar corners occur).
     fn soup(seed: u64, faces: usize, lattice: bool) -> (Vec<P3>, Vec<[u32; 3]>) {
         let mut rng = XorShift64::new(seed);
-        let pool = 3 * faces / 2 + 3;
-        let mut p = Vec::with_capacity(pool);
-        while p.len() < pool {
+        let clusters = faces / 3 + 1;
+        let mut p = Vec::with_capacity(5 * clusters);
+        for _ in 0..clusters {
             let c = rng.in_cube(1.0);
             let s = 10f64.powf(rng.uniform(-2.5, 0.0));
-            for _ in 0..3 {
+            for _ in 0..5 {
                 let d = rng.in_cube(s);
                 let mut q = [c[0] + d[0], c[1] + d[1], c[2] + d[2]];
                 if lattice {
-                    q = q.map(|x| (x * 4.0).round() / 4.0);
+                    q = q.map(|x| (x * 64.0).round() / 64.0);
                 }
                 p.push(q);
             }
         }
+        let mut pick = |n: u64| (rng.next_u64() % n) as u32;
         let t = (0..faces)
-            .map(|k| {
-                if rng.next_u64().is_multiple_of(3) {
-                    [0, 1, 2].map(|_| (rng.next_u64() % pool as u64) as u32)
+            .map(|_| {
+                if pick(10) == 0 {
+                    [0, 1, 2].map(|_| pick(p.len() as u64))
                 } else {
-                    let b = (3 * k % (pool - 2)) as u32;
-                    [b, b + 1, b + 2]
+                    let c = 5 * pick(clusters as u64);
+                    let a = pick(5);
+                    let b = (a + 1 + pick(4)) % 5;
+                    let mut d = pick(5);
+                    while d == a || d == b {
+                        d = (d + 1) % 5;
+                    }
+                    [c + a, c + b, c + d]
                 }
             })
             .collect();
