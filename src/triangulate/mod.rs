@@ -30,10 +30,10 @@ pub(crate) use crate::mesh::octahedron;
 pub use crate::mesh::{Mesh, Provenance};
 
 use crate::error::MeshError;
-use crate::sample::{CurveEnd, Samples};
 use crate::geom::vec3::{
     cross as cross3, dot as dot3, normalize as normalize3, sub as sub3, FastHash,
 };
+use crate::sample::{CurveEnd, Samples};
 use crate::scalar::Scalar;
 use spade::{ConstrainedDelaunayTriangulation, HasPosition, Point2, Triangulation as _};
 
