@@ -78,7 +78,7 @@ pub enum MeshError {
         why: &'static str,
     },
     /// The previous method needs at least three curves to span the tangent plane.
-    #[error("the previous method needs at least 3 curves (got {0}); use --curves 3 or more")]
+    #[error("the previous method needs at least 3 curves (got {0}); set `curves` of `Method::Previous` to 3 or more")]
     TooFewCurves(usize),
     /// The samples could not be triangulated (too few points, all points collinear in the chart…).
     #[error("could not triangulate the samples: {0}")]

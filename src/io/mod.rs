@@ -1,4 +1,4 @@
-//! Reading and writing: mesh files, reports, invariant files, pictures.
+//! Reading and writing: mesh files, run reports, and (with the `toml` feature) invariant files.
 //!
 //! # Mesh files
 //!
@@ -34,10 +34,10 @@ use crate::triangulate::Mesh;
 // ---------------------------------------------------------------------------
 // Submodules. Keep one `pub mod` per line, sorted; add new ones to this list.
 // ---------------------------------------------------------------------------
+#[cfg(feature = "toml")]
 pub mod invariant_file;
 pub mod obj;
 pub mod ply;
-pub mod render;
 pub mod report;
 pub mod stl;
 // ---------------------------------------------------------------------------

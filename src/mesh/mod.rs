@@ -1,7 +1,5 @@
 //! The finished mesh: what every stage after triangulation reads, and what the samples' provenance is recorded in.
 
-use serde::{Deserialize, Serialize};
-
 /// Where a vertex came from in the sampling stage.
 ///
 /// `curve` and `step` identify the integral curve and the accepted step on it
@@ -13,7 +11,8 @@ use serde::{Deserialize, Serialize};
 /// ([`Provenance::CLOSING_CURVE`]); vertices added by refinement carry
 /// [`Provenance::REFINED_CURVE`], the round that added them as `step`, and the arc length and
 /// angle of the vertex their chord started from.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct Provenance {
     /// Index of the integral curve the vertex lies on.
     pub curve: u32,
@@ -38,7 +37,8 @@ impl Provenance {
 ///
 /// All four vectors describing vertices have the same length, and every index
 /// in `triangles` is smaller than it.
-#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, Default, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct Mesh {
     /// Vertex positions.
     pub vertices: Vec<[f64; 3]>,

@@ -182,8 +182,9 @@ pub fn min<T: Scalar>(a: T, b: T) -> T {
 }
 
 /// The scalar types the command line can run the mesher on.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize)]
-#[serde(rename_all = "lowercase")]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(rename_all = "lowercase"))]
 pub enum ScalarKind {
     /// IEEE single precision.
     F32,
