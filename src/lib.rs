@@ -36,7 +36,7 @@
 //!
 //! A program that only meshes depends on `liemesh = { version = "0.1", default-features =
 //! false }`: the mesher, the model, the scalars, quality measures, audits and the PLY, OBJ and
-//! STL writers and readers, on num-traits, nalgebra, spade and thiserror.
+//! STL writers and readers, on num-traits, nalgebra, spade, thiserror and rustc-hash.
 #![warn(missing_docs)]
 #![deny(rustdoc::broken_intra_doc_links)]
 
