@@ -13,6 +13,10 @@
 //! | OBJ | ASCII | ASCII | positions, normals, triangles |
 //! | STL | binary | — | triangles with facet normals (`f32`) |
 //!
+//! A mesh read from a file that does not record provenance (OBJ; PLY without
+//! the `curve` property) has [`Provenance::UNKNOWN`](crate::Provenance::UNKNOWN)
+//! for every vertex rather than a made-up origin.
+//!
 //! Floating-point values are written so that reading them back gives the same
 //! `f64` bits: PLY stores them as `double`, OBJ and ASCII PLY print them with
 //! Rust's shortest round-trip formatting. Output is deterministic: the same
