@@ -125,9 +125,21 @@ pub fn main() -> ExitCode {
     match run(cli) {
         Ok(code) => code,
         Err(e) => {
-            eprintln!("liemesh: error: {e}");
+            eprintln!("liemesh: error: {}", for_the_command_line(&e));
             ExitCode::from(2)
         }
+    }
+}
+
+/// The error message as a command-line user needs it: the library's messages name parameters
+/// (`dt`, `beta_min`, ...), which are also the flags' names, except where the library names
+/// its own API.
+fn for_the_command_line(e: &CliError) -> String {
+    match e {
+        CliError::Mesh(liemesh::MeshError::TooFewCurves(n)) => {
+            format!("the previous method needs at least 3 curves (got {n}); use --curves 3 or more")
+        }
+        e => e.to_string(),
     }
 }
 
