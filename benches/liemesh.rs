@@ -11,14 +11,19 @@
 use criterion::{
     criterion_group, criterion_main, BenchmarkId, Criterion, SamplingMode, Throughput,
 };
-// The workloads of `liemesh bench`: β band (and Δt) shrunk by √(target / base).
-use liemesh::cli::workload_params as workload;
+// The workloads of `liemesh bench` (β band and Δt shrunk by √(target / base), the fidelity
+// scan), from the one file that defines them for both.
+#[allow(dead_code)]
+#[path = "../src/cli/workloads.rs"]
+mod workloads;
+
 use liemesh::model::LieField;
 use liemesh::preset::Preset;
 use liemesh::scalar::Dual;
 use spade::Triangulation as _;
 use std::hint::black_box;
 use std::time::Duration;
+use workloads::workload_params as workload;
 
 fn configure<'a>(
     c: &'a mut Criterion,
@@ -134,8 +139,7 @@ fn scalars(c: &mut Criterion) {
 fn fidelity(c: &mut Criterion) {
     let mut g = configure(c, "fidelity");
     for (ellipsoid, label) in [(false, "sphere"), (true, "ellipsoid")] {
-        let found =
-            liemesh::cli::fidelity_scan(ellipsoid, liemesh::cli::FIDELITY_MAX_TRIANGLES).unwrap();
+        let found = workloads::fidelity_scan(ellipsoid, workloads::FIDELITY_MAX_TRIANGLES).unwrap();
         assert!(found.reached, "{label}: {found:?}");
         let field = LieField::<f64>::new(&found.invariant);
         g.throughput(Throughput::Elements(found.triangles as u64));

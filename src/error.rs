@@ -78,7 +78,7 @@ pub enum MeshError {
         why: &'static str,
     },
     /// The previous method needs at least three curves to span the tangent plane.
-    #[error("the previous method needs at least 3 curves (got {0}); use --curves 3 or more")]
+    #[error("the previous method needs at least 3 curves (got {0}); set `curves` of `Method::Previous` to 3 or more")]
     TooFewCurves(usize),
     /// The finished mesh failed validation (a bug: please report the input).
     #[error(

@@ -23,14 +23,26 @@
 //! }
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
+//!
+//! # Cargo features
+//!
+//! | feature | default | what it adds | dependencies |
+//! |---|---|---|---|
+//! | `serde` | yes | `Serialize`/`Deserialize` for [`Mesh`], [`MeshParams`], the invariant, the quality, audit and [`io::report`] types | serde |
+//! | `toml` | yes | `io::invariant_file`: an invariant and mesher parameters in a TOML file (implies `serde`) | toml |
+//! | `parallel` | yes | relaxation, flips and refinement of large meshes on rayon's thread pool; without it they run on the calling thread, with bit-identical results | rayon |
+//! | `cli` | yes | the `liemesh` executable (implies the three above); nothing in the library | clap, serde_json, indicatif, tiny-skia, png, svg |
+//! | `mpfr` | no | `scalar::Mpfr<BITS>`, MPFR floats of `BITS` bits (builds GMP and MPFR from source; needs `m4`) | rug |
+//!
+//! A program that only meshes depends on `liemesh = { version = "0.1", default-features =
+//! false }`: the mesher, the model, the scalars, quality measures, audits and the PLY, OBJ and
+//! STL writers and readers, on num-traits, nalgebra, spade, thiserror and rustc-hash.
 #![warn(missing_docs)]
+#![deny(rustdoc::broken_intra_doc_links)]
 
 pub mod audit;
-pub mod cli;
 mod error;
 mod geom;
-#[doc(hidden)]
-pub mod fuzz_checks;
 pub mod io;
 pub mod mesh;
 pub mod model;
@@ -44,9 +56,18 @@ pub mod trace;
 pub mod triangulate;
 
 pub use error::MeshError;
+pub use mesh::{Mesh, Provenance};
 pub use model::NormalField;
 pub use params::{Budget, MeshParams, Method, Mode, Terminal};
-pub use mesh::{Mesh, Provenance};
+
+// The fuzz targets' checks (`fuzz/src/lib.rs`, written against the public API as
+// `liemesh::...`), compiled into the unit tests too.
+#[cfg(test)]
+extern crate self as liemesh;
+#[cfg(test)]
+#[allow(dead_code)]
+#[path = "../fuzz/src/lib.rs"]
+mod fuzz_checks;
 
 /// The README's examples, compiled and run as doctests.
 #[cfg(doctest)]
@@ -96,9 +117,10 @@ pub struct Timings {
 /// Samples and triangulates the surface of `field` (the whole pipeline), keeping the
 /// intermediate results.
 ///
-/// Meshes of a few thousand vertices and more are relaxed and flipped on rayon's current
-/// thread pool (call it inside [`rayon::ThreadPool::install`] to choose the threads); the
-/// result is bit-identical for any number of threads.
+/// With the `parallel` feature, meshes of a few thousand vertices and more are relaxed and
+/// flipped on rayon's current thread pool (call it inside rayon's `ThreadPool::install` to
+/// choose the threads); the result is bit-identical for any number of threads, and without
+/// the feature.
 pub fn run<T: Scalar, F: NormalField<T>>(
     field: &F,
     params: &MeshParams,

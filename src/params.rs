@@ -1,11 +1,11 @@
 //! Mesher parameters: everything the paper's Step 1 sets, plus terminal conditions and budgets.
 
 use crate::error::MeshError;
-use serde::{Deserialize, Serialize};
 
 /// How curves are laid out (DESIGN.md §2).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "lowercase", tag = "kind")]
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(rename_all = "lowercase", tag = "kind"))]
 pub enum Method {
     /// The previous method (paper refs \[5\]\[6\]): `curves` curves at uniform angles, no insertion.
     Previous {
@@ -18,8 +18,9 @@ pub enum Method {
 }
 
 /// How one step is taken.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "lowercase")]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(rename_all = "lowercase"))]
 pub enum Mode {
     /// Exactly the paper: explicit Euler (eq. 6), first-order AD prediction (eq. 8–9) and the
     /// δ/δ' retry loop of Step 5.
@@ -33,7 +34,8 @@ pub enum Mode {
 }
 
 /// When a curve ends (the paper's Step 7), besides budgets and singular points.
-#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct Terminal {
     /// Largest arc length from `p0` along a curve.
     pub max_radius: f64,
@@ -55,7 +57,8 @@ impl Default for Terminal {
 }
 
 /// Hard limits on every loop.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct Budget {
     /// Most sample points in total.
     pub max_points: usize,
@@ -83,7 +86,8 @@ impl Default for Budget {
 /// All parameters of one meshing run. Angles are in radians.
 ///
 /// The defaults are the fig3 preset's: see [`crate::preset`].
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct MeshParams {
     /// Curve layout.
     pub method: Method,
@@ -121,7 +125,10 @@ pub struct MeshParams {
     /// Refinement: split faces whose normal error (the angle between the face and the field
     /// normal at its centroid) exceeds this many radians, after the mesh is built. `None`
     /// (the presets' choice) leaves the mesh as built.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[cfg_attr(
+        feature = "serde",
+        serde(default, skip_serializing_if = "Option::is_none")
+    )]
     pub max_normal_error: Option<f64>,
 }
 

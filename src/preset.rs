@@ -19,7 +19,6 @@
 
 use crate::model::Invariant;
 use crate::params::{Budget, MeshParams, Method, Mode, Terminal};
-use serde::{Deserialize, Serialize};
 
 /// Table 2, Fig. 1–3: `A = I`, `B = C = 0` — the unit sphere.
 pub const SPHERE_INVARIANT: [f64; 18] = [
@@ -47,8 +46,9 @@ const INV_SQRT_3: f64 = 0.577_350_269_189_625_8;
 pub const FIG46_RADIUS: f64 = 1.0;
 
 /// One of the paper's figures.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize, clap::ValueEnum)]
-#[serde(rename_all = "lowercase")]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(rename_all = "lowercase"))]
 pub enum Preset {
     /// Sphere, previous method, 15 curves.
     Fig1,

@@ -1,5 +1,8 @@
 //! The command line as a user runs it.
 
+// Needs the `liemesh` executable: feature `cli`.
+#![cfg(feature = "cli")]
+
 use std::path::PathBuf;
 use std::process::Command;
 

@@ -1,6 +1,9 @@
 //! `liemesh batch` over the preset invariant files: one mesh and one report per input, and
 //! the same bytes whatever the number of threads.
 
+// Needs the `liemesh` executable: feature `cli`.
+#![cfg(feature = "cli")]
+
 use std::path::{Path, PathBuf};
 use std::process::Command;
 

@@ -1,6 +1,9 @@
 //! `liemesh bench --tiny --json` prints the expected keys with positive numbers, and judges the
 //! targets its workloads cover.
 
+// Needs the `liemesh` executable: feature `cli`.
+#![cfg(feature = "cli")]
+
 use std::process::Command;
 
 #[test]

@@ -1,5 +1,8 @@
 //! `liemesh paper -o DIR` writes six meshes, six pictures and the Table 3 comparison.
 
+// Needs the `liemesh` executable: feature `cli`.
+#![cfg(feature = "cli")]
+
 use std::process::Command;
 
 #[test]

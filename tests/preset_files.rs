@@ -1,5 +1,8 @@
 //! The invariant files shipped in `examples/presets/` describe exactly the presets.
 
+// Needs invariant files: feature `toml`.
+#![cfg(feature = "toml")]
+
 use liemesh::io::invariant_file::InvariantFile;
 use liemesh::model::LieField;
 use liemesh::preset::Preset;

@@ -2,7 +2,7 @@
 //! points and parameters near the paper's (DESIGN.md §4).
 //!
 //! Every case runs `liemesh::run` in `f64` and hands the result to
-//! [`liemesh::fuzz_checks::check_run`], the same check the `mesher` fuzz target uses. It holds
+//! `check_run` of `fuzz/src/lib.rs`, the same check the `mesher` fuzz target uses. It holds
 //! when the run returns a typed `MeshError` that fits the input (exactly the validation
 //! error for invalid parameters; a singular `p0`, a direction along the normal or an
 //! untriangulable sample set for valid ones), or a mesh with
@@ -23,7 +23,12 @@
 //!
 //! [`Topology`]: liemesh::quality::Topology
 
-use liemesh::fuzz_checks::check_run;
+// The fuzz targets' checks, the very file the `liemesh-fuzz` crate is built from.
+#[allow(dead_code)]
+#[path = "../fuzz/src/lib.rs"]
+mod fuzz_checks;
+
+use fuzz_checks::check_run;
 use liemesh::model::{Invariant, LieField};
 use liemesh::preset::{Preset, FIG46_INVARIANT};
 use liemesh::sample::CurveEnd;

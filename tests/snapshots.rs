@@ -5,7 +5,12 @@
 //! meshes, review and accept the new ones with `cargo insta review` (or regenerate them with
 //! `INSTA_UPDATE=always cargo test --test snapshots` and inspect the diff).
 
-use liemesh::fuzz_checks::{check_chart, check_chart_delaunay};
+// The fuzz targets' checks, the very file the `liemesh-fuzz` crate is built from.
+#[allow(dead_code)]
+#[path = "../fuzz/src/lib.rs"]
+mod fuzz_checks;
+
+use fuzz_checks::{check_chart, check_chart_delaunay};
 use liemesh::model::LieField;
 use liemesh::preset::Preset;
 use liemesh::quality::Topology;

@@ -6,10 +6,10 @@
 //!   against the closed form `J w = A w + B (2 p∘w)` of the model (lift `ℓ(p) = (p, p∘p)`)
 //!   evaluated in double-double arithmetic from the *same* `f64` matrices. This isolates the
 //!   rounding of the dual-number pass.
-//! - [`jvp_vs_mpfr`]: the `Dual<f64>` JVP of `LieField<f64>` against the JVP of
+//! - `jvp_vs_mpfr` (feature `mpfr`): the `Dual<f64>` JVP of `LieField<f64>` against the JVP of
 //!   `LieField<Mpfr<256>>` (a `Dual<Mpfr<256>>` pass, with `A`, `B` built in MPFR from the
 //!   invariant). This includes the rounding of the `f64` matrices.
-//! - [`jvp_vs_central_difference`]: the `Dual<Mpfr<256>>` JVP against the central difference
+//! - `jvp_vs_central_difference` (feature `mpfr`): the `Dual<Mpfr<256>>` JVP against the central difference
 //!   `(v(p + h w) − v(p − h w)) / 2h` of `LieField<Mpfr<512>>` with `h = 2^-100`: exact for
 //!   the quadratic fields of this model up to rounding (≈2^-412), and within `h² ≈ 6e-61` of
 //!   the derivative for any smooth field.

@@ -30,7 +30,6 @@ pub mod scalars;
 
 use crate::model::Invariant;
 use crate::preset::Preset;
-use serde::{Deserialize, Serialize};
 
 pub use rng::XorShift64;
 
@@ -38,7 +37,8 @@ pub use rng::XorShift64;
 pub const MPFR_AVAILABLE: bool = cfg!(feature = "mpfr");
 
 /// One audit figure.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct Row {
     /// What was checked, with the unit of `measured` (e.g. `"vertex error / bbox diagonal"`).
     pub check: String,

@@ -1,11 +1,11 @@
-//! `liemesh audit`: the accuracy audits of [`crate::audit`] as a table or JSON.
+//! `liemesh audit`: the accuracy audits of [`liemesh::audit`] as a table or JSON.
 //!
 //! Exit code 0 when every row passes, 1 when any row fails.
 
 use super::CliError;
-use crate::audit::{self, Row};
-use crate::preset::Preset;
 use clap::Args;
+use liemesh::audit::{self, Row};
+use liemesh::preset::Preset;
 use std::io::Write;
 use std::process::ExitCode;
 
@@ -13,7 +13,7 @@ use std::process::ExitCode;
 #[derive(Debug, Clone, Default, Args)]
 pub struct AuditArgs {
     /// Audit this preset; repeat the flag for several. All six when omitted.
-    #[arg(long, value_enum)]
+    #[arg(long, value_parser = super::preset_parser())]
     pub preset: Vec<Preset>,
     /// Print the rows as a JSON array instead of a table.
     #[arg(long)]

@@ -7,12 +7,12 @@
 
 use super::mesh::{mesh_invariant, write_json};
 use super::CliError;
-use crate::io::invariant_file::InvariantFile;
-use crate::io::report::Report;
-use crate::io::{self, MeshFormat, WriteOptions};
-use crate::scalar::ScalarKind;
-use crate::MeshParams;
 use clap::Args;
+use liemesh::io::invariant_file::InvariantFile;
+use liemesh::io::report::Report;
+use liemesh::io::{self, MeshFormat, WriteOptions};
+use liemesh::scalar::ScalarKind;
+use liemesh::MeshParams;
 use rayon::prelude::*;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;

@@ -1,12 +1,15 @@
 //! `liemesh bench`: the performance workloads of issue 6, timed once each (medians of a
 //! few repeats for the small ones), as a table or JSON.
 
+use super::workloads::{
+    fidelity_scan, workload_params, FIDELITY_LIMIT_DEG, FIDELITY_MAX_TRIANGLES,
+};
 use super::CliError;
-use crate::model::{Invariant, LieField, NormalField};
-use crate::preset::Preset;
-use crate::scalar::{Dual, Scalar};
-use crate::MeshParams;
 use clap::Args;
+use liemesh::model::{Invariant, LieField, NormalField};
+use liemesh::preset::Preset;
+use liemesh::scalar::{Dual, Scalar};
+use liemesh::MeshParams;
 use serde::Serialize;
 use spade::Triangulation as _;
 use std::process::ExitCode;
@@ -54,7 +57,7 @@ fn peak_resident_bytes() -> Option<u64> {
     Some(kb * 1024)
 }
 
-/// The child side of [`memory_row`]: meshes the workload through [`crate::run`] (the whole
+/// The child side of [`memory_row`]: meshes the workload through [`liemesh::run`] (the whole
 /// pipeline, working-precision vertices included) and prints `triangles peak_bytes`.
 fn memory_probe(workload: &str, target: &str) -> Result<ExitCode, CliError> {
     let ellipsoid = match workload {
@@ -70,7 +73,7 @@ fn memory_probe(workload: &str, target: &str) -> Result<ExitCode, CliError> {
         .parse()
         .map_err(|_| CliError::Usage(format!("`{target}` is not a triangle count")))?;
     let (inv, params) = workload_params(ellipsoid, target);
-    let run = crate::run(&LieField::<f64>::new(&inv), &params)?;
+    let run = liemesh::run(&LieField::<f64>::new(&inv), &params)?;
     let peak = peak_resident_bytes().ok_or_else(|| {
         CliError::Usage("peak memory needs Linux's /proc/self/status".to_string())
     })?;
@@ -111,10 +114,12 @@ pub struct WorkloadRow {
     pub points: usize,
     /// Sampling, ns per triangle.
     pub sample_ns_per_tri: f64,
-    /// Triangulation (chart Delaunay, flips, closing, assembly, and in the default mode the
-    /// relaxation with its flips), ns per triangle.
+    /// Triangulation of the samples (`liemesh::triangulate::triangulate`: chart Delaunay,
+    /// flips, closing, assembly), ns per triangle. The default mode's relaxation (with its
+    /// flip pass) is not a public function, so it is timed only as part of the total.
     pub triangulate_ns_per_tri: f64,
-    /// Sampling + triangulation, ns per triangle.
+    /// The whole pipeline (`liemesh::run`: sampling, triangulation and, in the default mode,
+    /// relaxation), timed by itself, ns per triangle.
     pub total_ns_per_tri: f64,
     /// spade's bulk load of the same chart points, ns per triangle.
     pub spade_ns_per_tri: f64,
@@ -144,19 +149,6 @@ pub struct FidelityRow {
     /// End-to-end time of that mesh (`liemesh::run`), milliseconds (median of repeats).
     pub ms: f64,
 }
-
-/// The face-normal error the fidelity workload must reach (degrees): what grid-based implicit
-/// meshers show at about 10^5 sphere triangles.
-pub const FIDELITY_LIMIT_DEG: f64 = 0.7;
-
-/// The fidelity scan stops beyond this many triangles (`--tiny`: a twentieth of it).
-pub const FIDELITY_MAX_TRIANGLES: usize = 400_000;
-
-/// The curve-insertion gap and merge distance (steps) the fidelity scan tries besides the
-/// presets' 1.8 and 0.7. Just before a new curve starts, neighbouring curves are almost a gap
-/// apart, and the faces between them are the obtuse ones whose normals stray most; at 1.3
-/// steps fewer of them need refining on the sphere.
-pub const FIDELITY_CLOSER_GAP: [f64; 2] = [1.3, 0.55];
 
 /// The ratios issue 6 asks for.
 #[derive(Debug, Clone, Serialize)]
@@ -270,36 +262,14 @@ fn targets(report: &BenchReport) -> Vec<TargetRow> {
     out
 }
 
-/// Parameters for the sphere (`ellipsoid = false`) or the ellipsoid `(1, 4, 16, 0, 0, 0)`
-/// meshed by the proposed method with the β band scaled so that the sphere gets roughly
-/// `target` triangles (fig3 gives about 2000 at β ∈ [4°, 8°]; count ∝ 1/β²).
-pub fn workload_params(ellipsoid: bool, target: usize) -> (Invariant, MeshParams) {
-    let numbers: [f64; 6] = if ellipsoid {
-        [1.0, 4.0, 16.0, 0.0, 0.0, 0.0]
-    } else {
-        [1.0, 1.0, 1.0, 0.0, 0.0, 0.0]
-    };
-    let invariant = Invariant::from_numbers(&numbers).expect("valid invariant");
-    let mut params = Preset::Fig3.params();
-    // The ellipsoid gets about 4.6 times the sphere's count at the same β band.
-    let base = if ellipsoid { 9000.0 } else { 2000.0 };
-    let s = (target as f64 / base).sqrt();
-    params.beta_min /= s;
-    params.beta_max /= s;
-    params.dt /= s;
-    params.p0 = if ellipsoid {
-        [0.0, 0.0, 0.25]
-    } else {
-        [0.0, 0.0, 1.0]
-    };
-    (invariant, params)
-}
-
 fn median(mut v: Vec<f64>) -> f64 {
     v.sort_by(f64::total_cmp);
     v[v.len() / 2]
 }
 
+/// Times `repeats` runs of the workload, each stage by itself: sampling, the triangulation of
+/// those samples, spade's bulk load of their chart points, and the whole pipeline
+/// ([`liemesh::run`]); each figure is the median over the repeats.
 fn time_workload(
     name: &str,
     invariant: &Invariant,
@@ -307,13 +277,13 @@ fn time_workload(
     repeats: usize,
 ) -> Result<WorkloadRow, CliError> {
     let field = LieField::<f64>::new(invariant);
-    let (mut ts, mut tt, mut tb) = (Vec::new(), Vec::new(), Vec::new());
+    let (mut ts, mut tt, mut tb, mut te) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
     let (mut triangles, mut points) = (0, 0);
     for _ in 0..repeats {
-        let run = crate::run(&field, params)?;
-        let samples = &run.samples;
-        let mesh = &run.mesh;
-        let chart: Vec<spade::Point2<f64>> = crate::triangulate::chart_points(samples)
+        let t5 = Instant::now();
+        let run = std::hint::black_box(liemesh::run(&field, params)?);
+        let t6 = Instant::now();
+        let chart: Vec<spade::Point2<f64>> = liemesh::triangulate::chart_points(&run.samples)
             .into_iter()
             .map(|[x, y]| spade::Point2::new(x, y))
             .collect();
@@ -322,101 +292,25 @@ fn time_workload(
             .map_err(|e| CliError::Usage(format!("spade bulk load failed: {e:?}")))?;
         let t4 = Instant::now();
         std::hint::black_box(dt);
-        let t = run.timings;
-        ts.push(t.sampling);
-        tt.push(t.triangulating + t.improving + t.refining);
+        ts.push(run.timings.sampling);
+        tt.push(run.timings.triangulating);
         tb.push((t4 - t3).as_secs_f64());
-        triangles = mesh.triangles.len();
-        points = samples.points.len();
+        te.push((t6 - t5).as_secs_f64());
+        triangles = run.mesh.triangles.len();
+        points = run.samples.points.len();
     }
     let per = 1e9 / triangles.max(1) as f64;
-    let (s, t, b) = (median(ts) * per, median(tt) * per, median(tb) * per);
+    let [s, t, b, e] = [ts, tt, tb, te].map(|v| median(v) * per);
     Ok(WorkloadRow {
         workload: name.to_string(),
         triangles,
         points,
         sample_ns_per_tri: s,
         triangulate_ns_per_tri: t,
-        total_ns_per_tri: s + t,
+        total_ns_per_tri: e,
         spade_ns_per_tri: b,
-        total_over_spade: (s + t) / b,
+        total_over_spade: e / b,
     })
-}
-
-/// What the fidelity scan found: the parameters of its mesh and what that mesh is like.
-#[derive(Debug, Clone)]
-pub struct FidelityScan {
-    /// The invariant (sphere or ellipsoid).
-    pub invariant: Invariant,
-    /// The parameters of the mesh found, refinement to [`FIDELITY_LIMIT_DEG`] included.
-    pub params: MeshParams,
-    /// Triangles of that mesh.
-    pub triangles: usize,
-    /// Vertices the refinement added to it.
-    pub refined: usize,
-    /// Its largest face-normal error, degrees.
-    pub max_error_deg: f64,
-    /// Whether it is within the limit (otherwise it is the trial with the lowest error).
-    pub reached: bool,
-}
-
-/// Scans the β band of [`workload_params`] downward (each trial 15 % narrower), at its own
-/// insertion gap and at [`FIDELITY_CLOSER_GAP`], refining each mesh to [`FIDELITY_LIMIT_DEG`],
-/// and keeps the mesh with the fewest triangles that got there. A scan at one gap stops once
-/// its mesh before refinement has more triangles than the best so far (narrower bands only
-/// add more), or beyond `max_triangles`. If none got there (the rounds or the point budget ran
-/// out), it keeps the trial with the lowest error, `reached == false`.
-pub fn fidelity_scan(ellipsoid: bool, max_triangles: usize) -> Result<FidelityScan, CliError> {
-    let (invariant, base) = workload_params(ellipsoid, if ellipsoid { 9000 } else { 2000 });
-    let field = LieField::<f64>::new(&invariant);
-    let trial = |[gap, merge]: [f64; 2], scale: f64| {
-        let mut params = base.clone();
-        params.gap = gap;
-        params.merge = merge;
-        params.beta_min *= scale;
-        params.beta_max *= scale;
-        params.dt *= scale;
-        params.max_normal_error = Some(FIDELITY_LIMIT_DEG.to_radians());
-        params
-    };
-    // The coarsest within the limit, else the lowest error.
-    let mut reached: Option<FidelityScan> = None;
-    let mut lowest: Option<FidelityScan> = None;
-    for gap in [[base.gap, base.merge], FIDELITY_CLOSER_GAP] {
-        // Start 4× coarser than the fig3 band.
-        let mut scale = 4.0;
-        while scale > 1e-3 {
-            let params = trial(gap, scale);
-            let run = crate::run(&field, &params)?;
-            let (error, _) = crate::quality::face_normal_error(&field, &run.mesh);
-            let refined = run.refinement.map_or(0, |r| r.added);
-            let triangles = run.mesh.triangles.len();
-            // Each added vertex split two triangles in two.
-            let unrefined = triangles.saturating_sub(2 * refined);
-            let within = error <= FIDELITY_LIMIT_DEG && triangles <= max_triangles;
-            let seen = || FidelityScan {
-                invariant: invariant.clone(),
-                params: params.clone(),
-                triangles,
-                refined,
-                max_error_deg: error,
-                reached: within,
-            };
-            if lowest.as_ref().is_none_or(|l| error < l.max_error_deg) {
-                lowest = Some(seen());
-            }
-            if within && reached.as_ref().is_none_or(|r| triangles < r.triangles) {
-                reached = Some(seen());
-            }
-            if triangles > max_triangles
-                || reached.as_ref().is_some_and(|r| unrefined > r.triangles)
-            {
-                break;
-            }
-            scale *= 0.85;
-        }
-    }
-    Ok(reached.or(lowest).expect("at least one trial"))
 }
 
 /// [`fidelity_scan`], then times its mesh end to end `repeats` times.
@@ -431,7 +325,7 @@ fn fidelity(
     let mut times = Vec::new();
     for _ in 0..repeats {
         let t0 = Instant::now();
-        std::hint::black_box(crate::generate(&field, params)?);
+        std::hint::black_box(liemesh::generate(&field, params)?);
         times.push(t0.elapsed().as_secs_f64() * 1e3);
     }
     Ok(FidelityRow {
@@ -452,10 +346,10 @@ fn time_sampling<T: Scalar, F: NormalField<T>>(
     repeats: usize,
 ) -> Result<f64, CliError> {
     let mut v = Vec::new();
-    std::hint::black_box(crate::sample::sample(field, params)?); // warm-up
+    std::hint::black_box(liemesh::sample::sample(field, params)?); // warm-up
     for _ in 0..repeats {
         let t0 = Instant::now();
-        std::hint::black_box(crate::sample::sample(field, params)?);
+        std::hint::black_box(liemesh::sample::sample(field, params)?);
         v.push(t0.elapsed().as_secs_f64() * 1e3);
     }
     Ok(median(v))
@@ -523,7 +417,7 @@ pub fn measure(args: &BenchArgs) -> Result<BenchReport, CliError> {
     ];
     #[cfg(feature = "mpfr")]
     let mpfr256_over_f64 = {
-        use crate::scalar::Mpfr;
+        use liemesh::scalar::Mpfr;
         let r = rep.min(3);
         let m64 = time_sampling(&LieField::<Mpfr<64>>::new(&inv), &params, r)?;
         fig6.push(("mpfr64".to_string(), m64));
@@ -533,13 +427,13 @@ pub fn measure(args: &BenchArgs) -> Result<BenchReport, CliError> {
         // ratio is the median over the rounds.
         let f64_field = LieField::<f64>::new(&inv);
         let m256_field = LieField::<Mpfr<256>>::new(&inv);
-        std::hint::black_box(crate::sample::sample(&m256_field, &params)?); // warm-up
+        std::hint::black_box(liemesh::sample::sample(&m256_field, &params)?); // warm-up
         let (mut m256, mut ratios) = (Vec::new(), Vec::new());
         let rounds = if args.tiny { 2 } else { 7 };
         for _ in 0..rounds {
             let f = time_sampling(&f64_field, &params, 5)?;
             let t0 = Instant::now();
-            std::hint::black_box(crate::sample::sample(&m256_field, &params)?);
+            std::hint::black_box(liemesh::sample::sample(&m256_field, &params)?);
             let m = t0.elapsed().as_secs_f64() * 1e3;
             m256.push(m);
             ratios.push(m / f);

@@ -1,14 +1,14 @@
 //! `liemesh mesh`.
 
 use super::CliError;
-use crate::io::invariant_file::{InvariantFile, ParamsPatch};
-use crate::io::report::Report;
-use crate::io::{self, WriteOptions};
-use crate::model::{Invariant, LieField};
-use crate::preset::Preset;
-use crate::scalar::{Dual, Scalar, ScalarKind};
-use crate::{Mesh, MeshError, MeshParams};
 use clap::Args;
+use liemesh::io::invariant_file::{InvariantFile, ParamsPatch};
+use liemesh::io::report::Report;
+use liemesh::io::{self, WriteOptions};
+use liemesh::model::{Invariant, LieField};
+use liemesh::preset::Preset;
+use liemesh::scalar::{Dual, Scalar, ScalarKind};
+use liemesh::{Mesh, MeshError, MeshParams};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::time::Instant;
@@ -17,7 +17,7 @@ use std::time::Instant;
 #[derive(Debug, Clone, Args)]
 pub struct MeshArgs {
     /// One of the paper's figures.
-    #[arg(long, value_enum, conflicts_with = "invariant")]
+    #[arg(long, value_parser = super::preset_parser(), conflicts_with = "invariant")]
     pub preset: Option<Preset>,
     /// A TOML invariant file (`invariant = [...]` and an optional `[mesh]` table).
     #[arg(long, value_name = "FILE")]
@@ -260,9 +260,9 @@ pub struct MeshOutcome {
     /// Wall-clock seconds of sampling and triangulation.
     pub seconds: f64,
     /// The quality report, when asked for.
-    pub quality: Option<crate::quality::QualityReport>,
+    pub quality: Option<liemesh::quality::QualityReport>,
     /// What refinement to a normal-error bound did, when asked for.
-    pub refinement: Option<crate::triangulate::Refinement>,
+    pub refinement: Option<liemesh::triangulate::Refinement>,
 }
 
 fn mesh_in<T: Scalar>(
@@ -272,10 +272,10 @@ fn mesh_in<T: Scalar>(
 ) -> Result<MeshOutcome, MeshError> {
     let field = LieField::<T>::new(invariant);
     let start = Instant::now();
-    let run = crate::run(&field, params)?;
+    let run = liemesh::run(&field, params)?;
     let seconds = start.elapsed().as_secs_f64();
     let quality = measure.then(|| {
-        crate::quality::QualityReport::measure(invariant, params, &run.samples, &run.mesh)
+        liemesh::quality::QualityReport::measure(invariant, params, &run.samples, &run.mesh)
     });
     Ok(MeshOutcome {
         curves: run.samples.curves.len(),
@@ -301,7 +301,7 @@ pub fn mesh_invariant(
         ScalarKind::Mpfr => {
             #[cfg(feature = "mpfr")]
             {
-                mesh_in::<crate::scalar::Mpfr<256>>(invariant, params, measure)?
+                mesh_in::<liemesh::scalar::Mpfr<256>>(invariant, params, measure)?
             }
             #[cfg(not(feature = "mpfr"))]
             {
@@ -339,7 +339,7 @@ pub(super) fn run(args: &MeshArgs) -> Result<ExitCode, CliError> {
         )?;
     }
     if let Some(png) = &args.png {
-        crate::io::render::render_to_file(&outcome.mesh, png, &args.picture.options())?;
+        super::picture::render_to_file(&outcome.mesh, png, &args.picture.options())?;
     }
     let mut report = Report::new(
         preset.map(|p| p.name().to_string()),

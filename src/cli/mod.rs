@@ -1,4 +1,6 @@
-//! The `liemesh` command line (in the library so that it can be tested like any other code).
+//! The `liemesh` command line: the binary's own modules, not part of the library (a program
+//! that depends on liemesh gets the mesher without clap, indicatif, tiny-skia, png, svg or
+//! serde_json). The tests in `tests/cli*.rs` run the built executable.
 //!
 //! Exit codes: 0 success, 1 a check failed (e.g. an audit row), 2 bad input or an error
 //! (the message on standard error says what was wrong and what to do).
@@ -8,18 +10,18 @@ mod batch;
 mod bench;
 mod mesh;
 mod paper;
+mod picture;
 mod quality;
 mod render;
+mod workloads;
 
+use clap::builder::TypedValueParser as _;
 use clap::{Parser, Subcommand};
+use liemesh::preset::Preset;
 use std::process::ExitCode;
 use thiserror::Error;
 
-pub use bench::{
-    fidelity_scan, workload_params, FidelityScan, FIDELITY_CLOSER_GAP, FIDELITY_LIMIT_DEG,
-    FIDELITY_MAX_TRIANGLES,
-};
-pub use mesh::{mesh_invariant, MeshArgs, MeshOutcome};
+pub use mesh::MeshArgs;
 
 /// Adaptive meshes of surfaces defined by Lie-algebra invariants.
 #[derive(Debug, Parser)]
@@ -58,19 +60,19 @@ pub enum Command {
 pub enum CliError {
     /// Mesh generation failed.
     #[error(transparent)]
-    Mesh(#[from] crate::MeshError),
+    Mesh(#[from] liemesh::MeshError),
     /// Reading or writing a mesh failed.
     #[error(transparent)]
-    Io(#[from] crate::io::IoError),
+    Io(#[from] liemesh::io::IoError),
     /// The invariant file is invalid.
     #[error(transparent)]
-    InvariantFile(#[from] crate::io::invariant_file::InvariantFileError),
+    InvariantFile(#[from] liemesh::io::invariant_file::InvariantFileError),
     /// The arguments contradict each other or name something unavailable.
     #[error("{0}")]
     Usage(String),
     /// Drawing a picture failed.
     #[error(transparent)]
-    Render(#[from] crate::io::render::RenderError),
+    Render(#[from] picture::RenderError),
     /// Writing a report failed.
     #[error("cannot write '{path}': {source}")]
     Write {
@@ -81,15 +83,63 @@ pub enum CliError {
     },
 }
 
+/// A preset as a command-line value: `fig1` … `fig6`, each with its description in `--help`.
+/// (The library's [`Preset`] does not depend on clap.)
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+struct PresetArg(Preset);
+
+impl clap::ValueEnum for PresetArg {
+    fn value_variants<'a>() -> &'a [Self] {
+        const ALL: [PresetArg; 6] = [
+            PresetArg(Preset::Fig1),
+            PresetArg(Preset::Fig2),
+            PresetArg(Preset::Fig3),
+            PresetArg(Preset::Fig4),
+            PresetArg(Preset::Fig5),
+            PresetArg(Preset::Fig6),
+        ];
+        &ALL
+    }
+
+    fn to_possible_value(&self) -> Option<clap::builder::PossibleValue> {
+        let help = match self.0 {
+            Preset::Fig1 => "Sphere, previous method, 15 curves",
+            Preset::Fig2 => "Sphere, previous method, 40 curves",
+            Preset::Fig3 => "Sphere, proposed method",
+            Preset::Fig4 => "Non-linear invariant, previous method, 15 curves",
+            Preset::Fig5 => "Non-linear invariant, previous method, 40 curves",
+            Preset::Fig6 => "Non-linear invariant, proposed method",
+        };
+        Some(clap::builder::PossibleValue::new(self.0.name()).help(help))
+    }
+}
+
+/// The value parser of every `--preset` flag.
+fn preset_parser() -> impl clap::builder::TypedValueParser<Value = Preset> {
+    clap::builder::EnumValueParser::<PresetArg>::new().map(|p| p.0)
+}
+
 /// Parses the process arguments, runs, and turns the result into an exit code.
 pub fn main() -> ExitCode {
     let cli = Cli::parse();
     match run(cli) {
         Ok(code) => code,
         Err(e) => {
-            eprintln!("liemesh: error: {e}");
+            eprintln!("liemesh: error: {}", for_the_command_line(&e));
             ExitCode::from(2)
         }
+    }
+}
+
+/// The error message as a command-line user needs it: the library's messages name parameters
+/// (`dt`, `beta_min`, ...), which are also the flags' names, except where the library names
+/// its own API.
+fn for_the_command_line(e: &CliError) -> String {
+    match e {
+        CliError::Mesh(liemesh::MeshError::TooFewCurves(n)) => {
+            format!("the previous method needs at least 3 curves (got {n}); use --curves 3 or more")
+        }
+        e => e.to_string(),
     }
 }
 

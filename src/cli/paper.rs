@@ -1,13 +1,13 @@
 //! `liemesh paper`: the paper's six figures and Table 3, reproduced.
 
+use super::picture::{render_to_file, RenderOptions};
 use super::CliError;
-use crate::io::render::{render_to_file, RenderOptions};
-use crate::io::{self, WriteOptions};
-use crate::preset::Preset;
-use crate::quality::Topology;
-use crate::scalar::ScalarKind;
-use crate::Mesh;
 use clap::Args;
+use liemesh::io::{self, WriteOptions};
+use liemesh::preset::Preset;
+use liemesh::quality::Topology;
+use liemesh::scalar::ScalarKind;
+use liemesh::Mesh;
 use std::fmt::Write as _;
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -90,7 +90,7 @@ pub fn reproduce(dir: &std::path::Path) -> Result<Vec<PaperRow>, CliError> {
     })?;
     let mut rows = Vec::new();
     for (preset, paper_meshes, paper_seconds) in PAPER_TABLE3 {
-        let outcome = super::mesh_invariant(
+        let outcome = super::mesh::mesh_invariant(
             &preset.invariant(),
             &preset.params(),
             ScalarKind::F64,

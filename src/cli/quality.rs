@@ -1,12 +1,12 @@
 //! `liemesh quality` and `liemesh recover`.
 
 use super::CliError;
-use crate::io::invariant_file::InvariantFile;
-use crate::model::{Invariant, LieField};
-use crate::params::Mode;
-use crate::preset::Preset;
-use crate::quality::{recover, QualityReport};
 use clap::Args;
+use liemesh::io::invariant_file::InvariantFile;
+use liemesh::model::{Invariant, LieField};
+use liemesh::preset::Preset;
+use liemesh::quality::{recover, QualityReport};
+use liemesh::Mode;
 use serde::Serialize;
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -16,7 +16,7 @@ use std::time::Instant;
 #[derive(Debug, Clone, Args)]
 pub struct QualityArgs {
     /// Presets to measure (all six by default).
-    #[arg(long, value_enum)]
+    #[arg(long, value_parser = super::preset_parser())]
     pub preset: Vec<Preset>,
     /// Print the rows as JSON.
     #[arg(long)]
@@ -41,12 +41,12 @@ pub struct QualityRow {
 /// Meshes `preset` in `mode` and measures it.
 pub fn quality_row(preset: Preset, mode: Mode) -> Result<QualityRow, CliError> {
     let invariant = preset.invariant();
-    let params = crate::MeshParams {
+    let params = liemesh::MeshParams {
         mode,
         ..preset.params()
     };
     let start = Instant::now();
-    let run = crate::run(&LieField::<f64>::new(&invariant), &params)?;
+    let run = liemesh::run(&LieField::<f64>::new(&invariant), &params)?;
     let milliseconds = start.elapsed().as_secs_f64() * 1e3;
     let quality = QualityReport::measure(&invariant, &params, &run.samples, &run.mesh);
     Ok(QualityRow {
@@ -112,7 +112,7 @@ pub struct RecoverArgs {
     #[arg(long)]
     pub hamiltonian: bool,
     /// Compare with this preset's invariant.
-    #[arg(long, value_enum, conflicts_with = "invariant")]
+    #[arg(long, value_parser = super::preset_parser(), conflicts_with = "invariant")]
     pub preset: Option<Preset>,
     /// Compare with the invariant in this file.
     #[arg(long)]
@@ -123,7 +123,7 @@ pub struct RecoverArgs {
 }
 
 pub(super) fn recover_cmd(args: &RecoverArgs) -> Result<ExitCode, CliError> {
-    let mesh = crate::io::read_mesh(&args.mesh)?;
+    let mesh = liemesh::io::read_mesh(&args.mesh)?;
     let reference: Option<Invariant> = match (&args.preset, &args.invariant) {
         (Some(p), _) => Some(p.invariant()),
         (None, Some(f)) => Some(InvariantFile::read(f)?.invariant),

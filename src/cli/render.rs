@@ -1,7 +1,7 @@
 //! `liemesh render`.
 
+use super::picture::{render_to_file, ColorBy, RenderOptions, View};
 use super::CliError;
-use crate::io::render::{render_to_file, ColorBy, RenderOptions, View};
 use clap::Args;
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -65,7 +65,7 @@ impl PictureArgs {
 }
 
 pub(super) fn run(args: &RenderArgs) -> Result<ExitCode, CliError> {
-    let mesh = crate::io::read_mesh(&args.mesh)?;
+    let mesh = liemesh::io::read_mesh(&args.mesh)?;
     render_to_file(&mesh, &args.output, &args.picture.options())?;
     Ok(ExitCode::SUCCESS)
 }

@@ -1,6 +1,6 @@
 //! Geometry on plain `f64` coordinates, below every pipeline stage that needs it: vector
-//! arithmetic on `[f64; 3]`, a fast hasher for integer keys, exact orientation predicates,
-//! exact triangle–triangle intersection and a broad phase for faces.
+//! arithmetic on `[f64; 3]`, the hasher of the integer-keyed tables (rustc-hash's Fx), exact
+//! orientation predicates, exact triangle–triangle intersection and a broad phase for faces.
 
 pub(crate) mod grid;
 pub(crate) mod intersect;

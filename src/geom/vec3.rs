@@ -1,8 +1,6 @@
 //! Plain `[f64; 3]` vector arithmetic for the geometric tests that run on `f64` copies of the
 //! points (sampling, triangulation, quality), and a fast hasher for their integer keys.
 
-use std::hash::Hasher;
-
 /// `a − b`.
 #[inline]
 pub(crate) fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
@@ -39,36 +37,14 @@ pub(crate) fn dist(a: [f64; 3], b: [f64; 3]) -> f64 {
     dot(d, d).sqrt()
 }
 
-/// A multiply-mix hasher for small integer keys (vertex pairs, grid cells): SipHash dominated
-/// the profiles of the tables that use it.
-#[derive(Default)]
-pub(crate) struct FastHasher(u64);
-
-impl Hasher for FastHasher {
-    #[inline]
-    fn finish(&self) -> u64 {
-        self.0
-    }
-    #[inline]
-    fn write(&mut self, bytes: &[u8]) {
-        for &b in bytes {
-            self.write_u64(self.0 ^ b as u64);
-        }
-    }
-    #[inline]
-    fn write_u32(&mut self, k: u32) {
-        self.write_u64(k as u64);
-    }
-    #[inline]
-    fn write_i32(&mut self, k: i32) {
-        self.write_u64(k as u32 as u64);
-    }
-    #[inline]
-    fn write_u64(&mut self, k: u64) {
-        let h = (self.0 ^ k).wrapping_mul(0x9E37_79B9_7F4A_7C15);
-        self.0 = h ^ (h >> 29);
-    }
-}
-
-/// `BuildHasher` for [`FastHasher`].
-pub(crate) type FastHash = std::hash::BuildHasherDefault<FastHasher>;
+/// The hasher of the tables keyed by small integers (vertex pairs, grid cells): rustc-hash's
+/// `FxBuildHasher`. SipHash, the standard one, dominated the profiles of those tables.
+///
+/// It replaced a hand-written multiply-mix hasher, measured against it on the whole pipeline
+/// (`liemesh bench --memory-probe`, one thread, CPU time, runs interleaved on a loaded
+/// two-core machine): sphere and ellipsoid at 10^5 triangles 219 and 280 ms against 220 and
+/// 277 ms (medians of 40 runs each), at 10^6 1.88 and 2.86 s against 1.93 and 3.08 s
+/// (medians of 8); 0.16 % fewer instructions (callgrind, 10^5). Not slower, so the
+/// maintained crate. Either hasher gives the same meshes, bit for bit (the tables are never
+/// iterated in hash order where the order reaches the output).
+pub(crate) type FastHash = rustc_hash::FxBuildHasher;

@@ -1,4 +1,4 @@
-//! Reading and writing: mesh files, reports, invariant files, pictures.
+//! Reading and writing: mesh files, run reports, and (with the `toml` feature) invariant files.
 //!
 //! # Mesh files
 //!
@@ -12,6 +12,10 @@
 //! | PLY | binary little-endian (default) or ASCII | ASCII, binary little- and big-endian | positions, normals, provenance, triangles |
 //! | OBJ | ASCII | ASCII | positions, normals, triangles |
 //! | STL | binary | — | triangles with facet normals (`f32`) |
+//!
+//! A mesh read from a file that does not record provenance (OBJ; PLY without
+//! the `curve` property) has [`Provenance::UNKNOWN`](crate::Provenance::UNKNOWN)
+//! for every vertex rather than a made-up origin.
 //!
 //! Floating-point values are written so that reading them back gives the same
 //! `f64` bits: PLY stores them as `double`, OBJ and ASCII PLY print them with
@@ -34,10 +38,10 @@ use crate::triangulate::Mesh;
 // ---------------------------------------------------------------------------
 // Submodules. Keep one `pub mod` per line, sorted; add new ones to this list.
 // ---------------------------------------------------------------------------
+#[cfg(feature = "toml")]
 pub mod invariant_file;
 pub mod obj;
 pub mod ply;
-pub mod render;
 pub mod report;
 pub mod stl;
 // ---------------------------------------------------------------------------

@@ -1,14 +1,15 @@
-//! The JSON run report (`--report FILE.json`).
+//! The run report: counts, topology, time and parameters of one meshing run (what the
+//! command line writes as JSON).
 
 use crate::model::Invariant;
 use crate::params::MeshParams;
 use crate::quality::Topology;
 use crate::scalar::ScalarKind;
 use crate::triangulate::Mesh;
-use serde::{Deserialize, Serialize};
 
 /// What a meshing run reports: counts, topology, time, and everything needed to rerun it.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct Report {
     /// Preset name, if the run used one.
     pub preset: Option<String>,
@@ -39,7 +40,10 @@ pub struct Report {
     /// Quality measures (shape, fidelity, topology, recovered invariant), when measured.
     pub quality: Option<crate::quality::QualityReport>,
     /// What refinement to [`MeshParams::max_normal_error`] did, when it was asked for.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[cfg_attr(
+        feature = "serde",
+        serde(default, skip_serializing_if = "Option::is_none")
+    )]
     pub refinement: Option<crate::triangulate::Refinement>,
 }
 

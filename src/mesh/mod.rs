@@ -3,8 +3,6 @@
 //! [`Mesh::validate`] checks any mesh for validity (manifold, oriented, non-degenerate,
 //! embedded) with exact predicates and reports what it found as a [`Validation`].
 
-use serde::{Deserialize, Serialize};
-
 mod validate;
 pub use validate::{Offenders, Validation, MAX_EXAMPLES};
 
@@ -23,8 +21,11 @@ pub(crate) fn crossings(p: &[[f64; 3]], tris: &[[u32; 3]]) -> Vec<(usize, usize)
 /// Vertices added to close a surface carry `curve == u32::MAX`
 /// ([`Provenance::CLOSING_CURVE`]); vertices added by refinement carry
 /// [`Provenance::REFINED_CURVE`], the round that added them as `step`, and the arc length and
-/// angle of the vertex their chord started from.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+/// angle of the vertex their chord started from. Vertices read from a file that does not
+/// record provenance (OBJ; PLY without a `curve` property) carry
+/// [`Provenance::UNKNOWN_CURVE`]: nothing is claimed about where they came from.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct Provenance {
     /// Index of the integral curve the vertex lies on.
     pub curve: u32,
@@ -41,6 +42,18 @@ impl Provenance {
     pub const CLOSING_CURVE: u32 = u32::MAX;
     /// Curve id given to vertices that refinement to a normal-error bound added.
     pub const REFINED_CURVE: u32 = u32::MAX - 1;
+    /// Curve id of vertices whose origin is unknown: read from a file that does not record
+    /// it (see [`Provenance::UNKNOWN`]).
+    pub const UNKNOWN_CURVE: u32 = u32::MAX - 2;
+    /// The provenance of a vertex read from a file that records none (an OBJ file, a PLY file
+    /// without provenance properties): curve [`Provenance::UNKNOWN_CURVE`], and `step`, `s`
+    /// and `theta` zero.
+    pub const UNKNOWN: Provenance = Provenance {
+        curve: Self::UNKNOWN_CURVE,
+        step: 0,
+        s: 0.0,
+        theta: 0.0,
+    };
 }
 
 /// A triangle mesh in `f64`: vertices, unit field normals at the vertices,
@@ -49,7 +62,8 @@ impl Provenance {
 ///
 /// All four vectors describing vertices have the same length, and every index
 /// in `triangles` is smaller than it.
-#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, Default, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct Mesh {
     /// Vertex positions.
     pub vertices: Vec<[f64; 3]>,

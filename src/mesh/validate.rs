@@ -18,7 +18,6 @@ use crate::geom::grid::{cell_size, radix_sort, spatial_order, Aabb, PairGrid};
 use crate::geom::intersect::{is_collinear, proper_corners_intersect};
 use crate::geom::predicates::{scale, Checked, Exponents, InRange, Orient, P3};
 use crate::par;
-use serde::{Deserialize, Serialize};
 use std::fmt;
 
 /// How many offenders of each kind a [`Validation`] names.
@@ -26,7 +25,8 @@ pub const MAX_EXAMPLES: usize = 16;
 
 /// How many offenders of one kind a mesh has, and the first [`MAX_EXAMPLES`] of them
 /// (the lowest, in ascending order, so the report does not depend on the order of the work).
-#[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[derive(Clone, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 #[non_exhaustive]
 pub struct Offenders<T> {
     /// How many there are.
@@ -74,7 +74,8 @@ impl<T: Ord + Copy> Offenders<T> {
 /// are reported and left out), so `vertices`, `edges`, `faces` and the Euler characteristic
 /// describe the remaining faces. Geometric checks (degeneracy, self-intersection) skip faces
 /// with a non-finite corner; self-intersection is tested among the non-degenerate faces.
-#[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[derive(Clone, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 #[non_exhaustive]
 pub struct Validation {
     /// Vertices referenced by a face (unreferenced vertices are allowed and not counted).
@@ -402,7 +403,7 @@ pub(crate) fn validate_listing_crossings(
         }
     };
     let (degenerate, crossings) = if faces.len() >= par::MIN_CHEAP {
-        rayon::join(topology_part, geometry_part).1
+        par::join(topology_part, geometry_part).1
     } else {
         topology_part();
         geometry_part()

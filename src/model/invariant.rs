@@ -1,7 +1,6 @@
 //! Invariants and the matrices they define (paper eq. 2–4, DESIGN.md §1).
 
 use crate::scalar::{Scalar, Vec3};
-use serde::{Deserialize, Serialize};
 use thiserror::Error;
 
 /// A 3×3 matrix as three rows.
@@ -28,8 +27,9 @@ pub enum InvariantError {
 }
 
 /// Which Lie algebra an invariant belongs to.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "lowercase")]
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(rename_all = "lowercase"))]
 pub enum InvariantKind {
     /// 6 numbers, `v = A p`.
     Linear,
@@ -44,7 +44,8 @@ pub enum InvariantKind {
 /// squares), so that `v(p)`, the upper block of `H ℓ(p)`, is `A p + B (p∘p)`: linear when
 /// `B = 0`, non-linear otherwise, as the paper's figures 4–6 are. `C` then does not change
 /// the 3-D field; it stays part of the invariant.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub enum Lift {
     /// `ℓ(p) = (p, p∘p)`.
     #[default]
@@ -99,7 +100,8 @@ impl Lift {
 /// let h = Invariant::from_numbers(&[1.0, 0.5, 0.0, 1.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 0.0]).unwrap();
 /// assert!(h.is_in_sp6());
 /// ```
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct Invariant {
     kind: InvariantKind,
     rows: [[f64; 6]; 3],

@@ -4,11 +4,11 @@ use crate::model::{jacobian, Invariant, NormalField};
 use crate::sample::Samples;
 use crate::scalar::{Scalar, Vec3};
 use crate::triangulate::Mesh;
-use serde::{Deserialize, Serialize};
 
 /// The normal turn actually achieved by the accepted steps (exact normals at both ends, not
 /// the predicted one), and the error of the first-order prediction. Angles in degrees.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct StepQuality {
     /// Accepted steps measured.
     pub steps: usize,
@@ -98,7 +98,10 @@ pub fn face_normal_error<F: NormalField<f64>>(field: &F, mesh: &Mesh) -> (f64, f
 /// One face's normal error: the angle in degrees between the face with `corners` and
 /// `normal_at` its centroid; 180 when that angle is NaN (a non-finite corner or field value),
 /// so that such a face counts as the worst.
-pub(crate) fn face_error_deg(
+///
+/// This is the error [`face_normal_error`] sums up and refinement to
+/// [`MeshParams::max_normal_error`](crate::MeshParams::max_normal_error) bounds.
+pub fn face_error_deg(
     corners: [[f64; 3]; 3],
     normal_at: impl FnOnce(&Vec3<f64>) -> Vec3<f64>,
 ) -> f64 {
@@ -114,7 +117,8 @@ pub(crate) fn face_error_deg(
 }
 
 /// Vertex drift from the level set through `p0`, for fields with a known potential.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct Drift {
     /// Largest distance of a vertex from the level set (`|F(p) − F(p0)| / |∇F(p)|`), divided by
     /// the mesh's bounding-box diagonal.

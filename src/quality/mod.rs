@@ -9,9 +9,9 @@ mod recover;
 mod shape;
 mod topology;
 
-pub(crate) use fidelity::face_error_deg;
 pub use fidelity::{
-    diagonal, drift, face_normal_error, integrability_defect, step_quality, Drift, StepQuality,
+    diagonal, drift, face_error_deg, face_normal_error, integrability_defect, step_quality, Drift,
+    StepQuality,
 };
 pub use recover::{decompose, jet_normals, mesh_normals, recover, Recovery};
 pub use shape::Shape;
@@ -22,10 +22,10 @@ use crate::params::MeshParams;
 use crate::sample::Samples;
 use crate::scalar::Scalar;
 use crate::triangulate::Mesh;
-use serde::{Deserialize, Serialize};
 
 /// Every quality measure of one mesh. Angles in degrees.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct QualityReport {
     /// Triangle shape.
     pub shape: Shape,

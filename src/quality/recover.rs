@@ -7,14 +7,14 @@
 //! solution of unit norm is the right singular vector of the smallest singular value. It is
 //! scaled to the reference by least squares and decomposed as `A = diag(λ) Rx(θ) Ry(φ) Rz(ψ)`.
 
-use crate::model::Invariant;
 use crate::geom::vec3::{cross, dot, normalize, sub};
+use crate::model::Invariant;
 use crate::triangulate::Mesh;
 use nalgebra::{DMatrix, Matrix3};
-use serde::{Deserialize, Serialize};
 
 /// What was recovered.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct Recovery {
     /// Recovered `A` (row-major), scaled to the reference when one was given, else to unit
     /// Frobenius norm of `[A B]`.

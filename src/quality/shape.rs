@@ -1,10 +1,10 @@
 //! Triangle shape: angles, radius-edge ratios, edge lengths.
 
 use crate::triangulate::Mesh;
-use serde::{Deserialize, Serialize};
 
 /// Shape statistics of a mesh's triangles (angles in degrees).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct Shape {
     /// Smallest angle of any triangle.
     pub min_angle: f64,

@@ -1,14 +1,14 @@
 //! Topology of a triangle mesh: manifoldness, orientation, boundary, Euler characteristic.
 
 use crate::triangulate::Mesh;
-use serde::{Deserialize, Serialize};
 use std::collections::HashMap;
 
 /// A fast hasher for edge keys (the counts do not depend on iteration order).
 type EdgeHash = crate::geom::vec3::FastHash;
 
 /// Topological facts about a mesh.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct Topology {
     /// Vertices referenced by at least one triangle.
     pub vertices: usize,

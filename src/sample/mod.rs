@@ -11,19 +11,20 @@
 mod grid;
 
 use crate::error::MeshError;
-use crate::params::{MeshParams, Method, Mode};
 use crate::geom::vec3::{dist, dot, sub};
+use crate::mesh::Provenance;
+use crate::params::{MeshParams, Method, Mode};
 use crate::scalar::{Scalar, Vec3};
 use crate::trace::{self, StepConfig, StepLimit};
-use crate::mesh::Provenance;
 use crate::NormalField;
 use grid::Grid;
 use std::cmp::Reverse;
 use std::collections::BinaryHeap;
 
 /// How a curve ended.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
-#[serde(rename_all = "snake_case")]
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(rename_all = "snake_case"))]
 pub enum CurveEnd {
     /// Reached the maximum geodesic radius.
     Radius,

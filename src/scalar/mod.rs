@@ -2,7 +2,7 @@
 //!
 //! [`Scalar`] is implemented for `f32`, `f64`, the forward-mode dual number [`Dual<T>`]
 //! (itself generic over any `Scalar`, so `Dual<Dual<f64>>` and `Dual<Mpfr<256>>` work) and,
-//! with the `mpfr` feature, the arbitrary-precision [`Mpfr<BITS>`](crate::scalar::Mpfr).
+//! with the `mpfr` feature, the arbitrary-precision `Mpfr<BITS>`.
 //!
 //! The trait is `Clone`-based rather than `Copy`-based because an MPFR float owns heap
 //! memory. For `f32` and `f64` a clone is a register copy, so generic code compiled for
@@ -182,8 +182,9 @@ pub fn min<T: Scalar>(a: T, b: T) -> T {
 }
 
 /// The scalar types the command line can run the mesher on.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize)]
-#[serde(rename_all = "lowercase")]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(rename_all = "lowercase"))]
 pub enum ScalarKind {
     /// IEEE single precision.
     F32,

@@ -8,8 +8,8 @@
 //! normal; flips that undo a fold (a face against the field normal) come first.
 
 use super::rows_by_corner;
-use crate::par;
 use crate::geom::vec3::{cross, dot, sub, FastHash};
+use crate::par;
 use std::collections::{HashMap, VecDeque};
 
 /// Angle at `c` in triangle (a, b, c).

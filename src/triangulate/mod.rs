@@ -21,7 +21,6 @@ mod refine;
 mod relax;
 mod stitch;
 mod untangle;
-mod reopen;
 
 pub(crate) use refine::refine;
 pub use refine::{Refinement, MAX_REFINE_ROUNDS};
@@ -35,12 +34,12 @@ pub(crate) use crate::mesh::octahedron;
 pub use crate::mesh::{Mesh, Provenance};
 
 use crate::error::MeshError;
-use crate::sample::{CurveEnd, Samples};
 use crate::geom::vec3::{
-    cross as cross3, dist as dist3, dot as dot3, normalize as normalize3, sub as sub3, FastHash,
+    cross as cross3, dist as dist3, sub as sub3,
 };
 use crate::model::LocalShape;
 use crate::params::MeshParams;
+use crate::sample::{CurveEnd, Samples};
 use crate::scalar::{Scalar, Vec3};
 use crate::trace::StepConfig;
 use crate::NormalField;
@@ -581,50 +580,6 @@ fn inside_star(chart: &[[f64; 2]], front: &[u32], (a0, rel): (f64, &[f64]), c: [
     cross2(sub2(b, a), sub2(c, a)) >= 0.0
 }
 
-/// Chart 2: triangulates the hole bounded by the front polygon in the plane across the mean
-/// normal of its vertices. Returns no triangles when the projected polygon is not simple.
-fn close_hole(
-    front: &[u32],
-    pos: &[[f64; 3]],
-    normals: &[[f64; 3]],
-    existing: &[[u32; 3]],
-) -> Vec<[u32; 3]> {
-    let m = front.len();
-    let Some([f1, f2, _]) = frame_around(normals.iter().copied()) else {
-        return Vec::new();
-    };
-    let proj: Vec<[f64; 2]> = front
-        .iter()
-        .map(|&i| {
-            let p = pos[i as usize];
-            [dot3(p, f1), dot3(p, f2)]
-        })
-        .collect();
-    // Chart 1 lies to the left of the front, so seen from outside the hole the front runs
-    // clockwise; when its projection does not (a curve overshot the hole), triangles that are
-    // counter-clockwise in the projection would disagree with chart 1's orientation, and
-    // ears are cut instead.
-    let Some(out) = reopen::fill_flat(front, m, &proj) else {
-        return clip_ears(front, pos, normals, existing);
-    };
-    // A diagonal of the hole that chart 1 already has as an edge would make the mesh
-    // non-manifold: cut ears instead, which never repeat an edge.
-    let mut have: EdgeSet = edges_among(existing, front, pos.len())
-        .into_iter()
-        .collect();
-    for t in &out {
-        for k in 0..3 {
-            let (a, b) = (t[k], t[(k + 1) % 3]);
-            // The hole's triangles use each loop edge in the opposite direction to chart 1,
-            // and any other edge must be new.
-            if have.contains(&(a, b)) || !have.insert((a, b)) {
-                return clip_ears(front, pos, normals, existing);
-            }
-        }
-    }
-    out
-}
-
 /// Rows by vertex, in triangle order: `value(t, k)` for every corner `k` of every triangle
 /// `t`, filed under the corner's vertex (compressed rows: vertex `v`'s values are
 /// `list[start[v]..start[v + 1]]`). Returns `(start, list)`, or `None` if a corner is not
@@ -652,189 +607,6 @@ fn rows_by_corner(
         }
     }
     Some((start, list))
-}
-
-/// A right-handed frame `(f1, f2, n)` whose `n` is the mean of `normals`, or `None` when they
-/// cancel out (or are not finite).
-fn frame_around(normals: impl Iterator<Item = [f64; 3]>) -> Option<[[f64; 3]; 3]> {
-    let mut mean = [0.0; 3];
-    for n in normals {
-        for k in 0..3 {
-            mean[k] += n[k];
-        }
-    }
-    let len = dot3(mean, mean).sqrt();
-    if len.is_nan() || len <= 0.0 {
-        return None;
-    }
-    let nm = mean.map(|x| x / len);
-    let helper = if nm[0].abs() < 0.9 {
-        [1.0, 0.0, 0.0]
-    } else {
-        [0.0, 1.0, 0.0]
-    };
-    let f1 = normalize3(cross3(helper, nm));
-    Some([f1, cross3(nm, f1), nm])
-}
-
-/// Rings of chart-1 vertices around a closing that [`folds_near_the_hole`] flips with it.
-const HOLE_RINGS: usize = 4;
-
-/// Whether the closing still folds after surface-Delaunay flips among its own triangles and
-/// the chart-1 triangles within [`HOLE_RINGS`] rings of its vertices (a small part of the
-/// mesh). Flips elsewhere do not reach a fold there, so the flip pass over the whole mesh
-/// would leave it too (debug builds check that); `false` also when the region is not a
-/// manifold the pass can flip.
-fn folds_near_the_hole(
-    chart: &[[u32; 3]],
-    closing: &[[u32; 3]],
-    pos: &[[f64; 3]],
-    normals: &[[f64; 3]],
-) -> bool {
-    let mut near = vec![false; pos.len()];
-    for &v in closing.iter().flatten() {
-        near[v as usize] = true;
-    }
-    let touches = |t: &[u32; 3], near: &[bool]| t.iter().any(|&v| near[v as usize]);
-    for _ in 0..HOLE_RINGS {
-        let mut grown = near.clone();
-        for t in chart.iter().filter(|t| touches(t, &near)) {
-            for &v in t {
-                grown[v as usize] = true;
-            }
-        }
-        near = grown;
-    }
-    let mut region: Vec<[u32; 3]> = chart
-        .iter()
-        .filter(|t| touches(t, &near))
-        .copied()
-        .collect();
-    region.extend_from_slice(closing);
-    let budget = 8 * region.len() + 64;
-    flip::flip_to_surface_delaunay(pos, normals, &mut region, budget).folded == Some(true)
-}
-
-/// Whether any of `triangles` faces against the field normal at its corners (a closing
-/// triangle across a thin, twisted hole can): the flip pass's own test.
-fn folds(triangles: &[[u32; 3]], pos: &[[f64; 3]], normals: &[[f64; 3]]) -> bool {
-    triangles
-        .iter()
-        .any(|&t| flip::against_field(pos, normals, t))
-}
-
-/// Whether `closing` meets `chart` edge to edge: every directed edge is used once, and every
-/// edge of the union by at most two triangles in opposite directions.
-///
-/// Chart 1 alone is the inner faces of one planar triangulation, so only its edges between
-/// vertices of `closing` can clash: those and `closing`'s are checked.
-fn stitches_cleanly(chart: &[[u32; 3]], closing: &[[u32; 3]], vertices: usize) -> bool {
-    let used: Vec<u32> = closing.iter().flatten().copied().collect();
-    let mut directed: EdgeSet = edges_among(chart, &used, vertices).into_iter().collect();
-    closing
-        .iter()
-        .all(|t| (0..3).all(|k| t[k] != t[(k + 1) % 3] && directed.insert((t[k], t[(k + 1) % 3]))))
-}
-
-/// Directed-edge sets keyed by vertex pairs.
-type EdgeSet = std::collections::HashSet<(u32, u32), FastHash>;
-
-/// The directed edges of `triangles` whose ends are both among `among` (indices below
-/// `vertices`; larger ones are ignored): what a hole's triangles, whose corners are all on
-/// its loop, can clash with, found without hashing every edge of the mesh.
-fn edges_among(triangles: &[[u32; 3]], among: &[u32], vertices: usize) -> Vec<(u32, u32)> {
-    let mut mark = vec![false; vertices];
-    for &v in among {
-        if let Some(m) = mark.get_mut(v as usize) {
-            *m = true;
-        }
-    }
-    let on = |v: u32| mark.get(v as usize).copied().unwrap_or(false);
-    triangles
-        .iter()
-        .flat_map(|t| (0..3).map(move |k| (t[k], t[(k + 1) % 3])))
-        .filter(|&(a, b)| on(a) && on(b))
-        .collect()
-}
-
-/// Closes a hole whose projection is not a simple polygon (e.g. the thin band an ellipsoid's
-/// curves leave along a caustic): repeatedly cuts off the ear with the smallest angle inside
-/// the hole, measured in space about the field normal, never creating an edge twice.
-fn clip_ears(
-    front: &[u32],
-    pos: &[[f64; 3]],
-    normals: &[[f64; 3]],
-    existing: &[[u32; 3]],
-) -> Vec<[u32; 3]> {
-    // (sample index, normal) around the loop; the hole lies to the right of the loop.
-    let mut ring: Vec<(u32, [f64; 3])> =
-        front.iter().copied().zip(normals.iter().copied()).collect();
-    // Every edge the mesh already has: an ear must not repeat one (that would make it
-    // non-manifold).
-    let mut edges: EdgeSet = edges_among(existing, front, pos.len())
-        .into_iter()
-        .map(|(a, b)| (a.min(b), a.max(b)))
-        .collect();
-    let mut out = Vec::with_capacity(ring.len());
-    while ring.len() > 3 {
-        let m = ring.len();
-        let mut best: Option<(f64, usize)> = None;
-        for i in 0..m {
-            let (a, b, c) = (ring[(i + m - 1) % m].0, ring[i].0, ring[(i + 1) % m].0);
-            if edges.contains(&(a.min(c), a.max(c))) {
-                continue;
-            }
-            let u = sub3(pos[a as usize], pos[b as usize]);
-            let w = sub3(pos[c as usize], pos[b as usize]);
-            let angle = dot3(ring[i].1, cross3(u, w))
-                .atan2(dot3(u, w))
-                .rem_euclid(std::f64::consts::TAU);
-            if best.is_none_or(|(b, _)| angle < b) {
-                best = Some((angle, i));
-            }
-        }
-        let Some((_, i)) = best else {
-            return Vec::new();
-        };
-        let (a, b, c) = (ring[(i + m - 1) % m].0, ring[i].0, ring[(i + 1) % m].0);
-        out.push([c, b, a]);
-        edges.insert((a.min(c), a.max(c)));
-        ring.remove(i);
-    }
-    out.push([ring[2].0, ring[1].0, ring[0].0]);
-    out
-}
-
-/// Twice the signed area of the closed polygon: positive when it runs counter-clockwise.
-fn signed_area(p: &[[f64; 2]]) -> f64 {
-    let m = p.len();
-    (0..m).map(|i| cross2(p[i], p[(i + 1) % m])).sum()
-}
-
-/// No two non-adjacent edges of the closed polygon meet (O(m²): the hole is small).
-fn simple_polygon(p: &[[f64; 2]]) -> bool {
-    let m = p.len();
-    if m > 4096 {
-        return false;
-    }
-    let seg = |i: usize| (p[i], p[(i + 1) % m]);
-    for i in 0..m {
-        for j in i + 1..m {
-            if j == i + 1 || (i == 0 && j == m - 1) {
-                continue;
-            }
-            let (a, b) = seg(i);
-            let (c, d) = seg(j);
-            let o1 = cross2(sub2(b, a), sub2(c, a));
-            let o2 = cross2(sub2(b, a), sub2(d, a));
-            let o3 = cross2(sub2(d, c), sub2(a, c));
-            let o4 = cross2(sub2(d, c), sub2(b, c));
-            if o1 * o2 <= 0.0 && o3 * o4 <= 0.0 {
-                return false;
-            }
-        }
-    }
-    true
 }
 
 fn point_in_polygon(p: &[[f64; 2]], c: [f64; 2]) -> bool {

@@ -25,7 +25,6 @@ use crate::quality::face_error_deg;
 use crate::scalar::{Scalar, Vec3};
 use crate::trace::{self, StepConfig};
 use crate::NormalField;
-use serde::{Deserialize, Serialize};
 
 /// Most rounds of splits. Each round splits at most one edge per neighbourhood, and a bad
 /// face's propagation path may take a few rounds to reach it.
@@ -49,7 +48,8 @@ const MAX_PATH: usize = 64;
 /// assert!(face_normal_error(&field, &run.mesh).0 <= 1.0);
 /// # Ok::<(), Box<dyn std::error::Error>>(())
 /// ```
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct Refinement {
     /// Rounds of splits made.
     pub rounds: usize,

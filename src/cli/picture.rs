@@ -27,43 +27,8 @@
 //! fine mesh; where large triangles interpenetrate or overlap cyclically in
 //! depth it can draw the wrong one on top, as any depth-sort renderer does.
 //!
-//! # Example
-//!
-//! ```
-//! use liemesh::io::render::{render_png, render_svg, ColorBy, RenderOptions, View};
-//! use liemesh::triangulate::{Mesh, Provenance};
-//!
-//! // A regular octahedron; the triangles are counter-clockwise seen from outside.
-//! let vertices = vec![
-//!     [1.0, 0.0, 0.0], [-1.0, 0.0, 0.0],
-//!     [0.0, 1.0, 0.0], [0.0, -1.0, 0.0],
-//!     [0.0, 0.0, 1.0], [0.0, 0.0, -1.0],
-//! ];
-//! let provenance = Provenance { curve: Provenance::CLOSING_CURVE, step: 0, s: 0.0, theta: 0.0 };
-//! let mesh = Mesh {
-//!     normals: vertices.clone(),
-//!     provenance: vec![provenance; vertices.len()],
-//!     vertices,
-//!     triangles: vec![
-//!         [0, 2, 4], [2, 1, 4], [1, 3, 4], [3, 0, 4],
-//!         [2, 0, 5], [1, 2, 5], [3, 1, 5], [0, 3, 5],
-//!     ],
-//! };
-//!
-//! let options = RenderOptions {
-//!     width: 200,
-//!     height: 200,
-//!     view: View::Orthographic { direction: [1.0, 0.7, 0.5], up: [0.0, 0.0, 1.0] },
-//!     color_by: ColorBy::MinAngle,
-//!     ..RenderOptions::default()
-//! };
-//! let png = render_png(&mesh, &options)?;
-//! assert!(png.starts_with(b"\x89PNG"));
-//!
-//! let svg = render_svg(&mesh, &options)?;
-//! assert_eq!(svg.matches("<polygon").count(), 8);
-//! # Ok::<(), liemesh::io::render::RenderError>(())
-//! ```
+//! This module is the binary's (`liemesh render`, `liemesh mesh --png`, `liemesh paper`), not
+//! the library's: a program that depends on liemesh does not build tiny-skia, png and svg.
 
 use std::path::{Path, PathBuf};
 
@@ -73,7 +38,7 @@ use tiny_skia::{
     Color, FillRule, LineCap, LineJoin, Paint, PathBuilder, Pixmap, Stroke, Transform,
 };
 
-use crate::triangulate::Mesh;
+use liemesh::Mesh;
 
 /// Largest accepted image width or height, in pixels.
 pub const MAX_IMAGE_SIZE: u32 = 16384;
@@ -1100,12 +1065,49 @@ fn opacity(alpha: u8) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::triangulate::Provenance;
+    use liemesh::triangulate::Provenance;
     use std::collections::HashMap;
 
+    /// The octahedron with corners ±x, ±y, ±z, faces counter-clockwise seen from outside.
     fn octahedron() -> Mesh {
-        let (vertices, triangles) = crate::triangulate::octahedron();
+        let vertices = vec![
+            [1.0, 0.0, 0.0],
+            [-1.0, 0.0, 0.0],
+            [0.0, 1.0, 0.0],
+            [0.0, -1.0, 0.0],
+            [0.0, 0.0, 1.0],
+            [0.0, 0.0, -1.0],
+        ];
+        let triangles = vec![
+            [0, 2, 4],
+            [2, 1, 4],
+            [1, 3, 4],
+            [3, 0, 4],
+            [2, 0, 5],
+            [1, 2, 5],
+            [3, 1, 5],
+            [0, 3, 5],
+        ];
         with_normals(vertices, triangles)
+    }
+
+    /// The example that was this module's doctest while it was in the library.
+    #[test]
+    fn octahedron_in_png_and_svg() {
+        let options = RenderOptions {
+            width: 200,
+            height: 200,
+            view: View::Orthographic {
+                direction: [1.0, 0.7, 0.5],
+                up: [0.0, 0.0, 1.0],
+            },
+            color_by: ColorBy::MinAngle,
+            ..RenderOptions::default()
+        };
+        let png = render_png(&octahedron(), &options).unwrap();
+        assert!(png.starts_with(b"\x89PNG"));
+        let svg = render_svg(&octahedron(), &options).unwrap();
+        assert_eq!(svg.matches("<polygon").count(), 8);
     }
 
     fn with_normals(vertices: Vec<[f64; 3]>, triangles: Vec<[u32; 3]>) -> Mesh {

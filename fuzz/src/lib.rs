@@ -1,7 +1,13 @@
-//! Input decoders and output checks shared by the cargo-fuzz targets in `fuzz/` and the
-//! corpus replay in `tests/fuzz_corpus.rs` (and the output checks by `tests/properties.rs`).
+//! Input decoders and output checks of the cargo-fuzz targets (`fuzz/fuzz_targets/*.rs`).
 //!
-//! Every fuzz target is one function `fn(&[u8]) -> Result<(), Violation>` of this module
+//! This file is the `liemesh-fuzz` crate's library, and the very same file is compiled into
+//! the main crate's tests with `#[path = ".../fuzz/src/lib.rs"] mod fuzz_checks;`: the corpus
+//! replay in `tests/fuzz_corpus.rs` (on stable Rust), the output checks in
+//! `tests/properties.rs`, `tests/snapshots.rs` and others, and the library's own unit tests.
+//! So it uses liemesh only through its public API (as `liemesh::...`), and depends on nothing
+//! but liemesh, `arbitrary`, `robust` and `spade`.
+//!
+//! Every fuzz target is one function `fn(&[u8]) -> Result<(), Violation>` of this file
 //! ([`TARGETS`]): the fuzz binary calls it and panics on a [`Violation`], and the replay test
 //! calls the very same function on every committed corpus file, so both read the bytes the
 //! same way (through [`arbitrary::Unstructured`] and `arbitrary_take_rest`) and check the
@@ -13,24 +19,37 @@
 //! | [`mesher`] | a [`MesherInput`]: an invariant and parameters near a preset's, or raw | [`check_run`] |
 //! | [`triangulate`] | a [`TriangulateInput`]: samples from a short run or synthetic, then edited (NaN, infinities, duplicates, collinear points, huge/tiny values, inconsistent curves) | [`check_triangulation`] |
 //! | [`invariant_file`] | bytes as an invariant file, a PLY and an OBJ file | [`check_invariant_file`], [`check_read_mesh`] |
-//!
-//! This module is not part of the stable API.
 
-use crate::io::invariant_file::{InvariantFile, InvariantFileError};
-use crate::io::{read_obj, read_ply, write_obj, write_ply, PlyEncoding};
-use crate::model::{Invariant, InvariantError, LieField};
-use crate::preset::Preset;
-use crate::quality::Topology;
-use crate::sample::{Curve, CurveEnd, Samples, StepRecord};
-use crate::geom::vec3::{cross as cross3, sub as sub3};
-use crate::scalar::Vec3;
-use crate::trace::StepLimit;
-use crate::triangulate::{ChartTriangulation, Mesh, Provenance};
-use crate::{Budget, MeshError, MeshParams, MeshRun, Method, Mode, NormalField};
 use arbitrary::{Arbitrary, Unstructured};
+#[cfg(feature = "toml")]
+use liemesh::io::invariant_file::{InvariantFile, InvariantFileError};
+use liemesh::io::{read_obj, read_ply, write_obj, write_ply, PlyEncoding};
+use liemesh::model::{Invariant, InvariantError, LieField};
+use liemesh::preset::Preset;
+use liemesh::quality::Topology;
+use liemesh::sample::{Curve, CurveEnd, Samples, StepRecord};
+use liemesh::scalar::Vec3;
+use liemesh::trace::StepLimit;
+use liemesh::triangulate::{ChartTriangulation, Mesh, Provenance};
+use liemesh::{Budget, MeshError, MeshParams, MeshRun, Method, Mode, NormalField};
 use std::collections::{HashMap, HashSet};
 use std::fmt;
+#[cfg(feature = "toml")]
 use std::path::Path;
+
+/// `a − b`.
+fn sub3(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+}
+
+/// `a × b`.
+fn cross3(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ]
+}
 
 /// A broken output invariant: what was expected and what was found.
 #[derive(Clone, Debug, PartialEq, Eq)]
@@ -309,7 +328,7 @@ impl MesherInput {
             shrink: self.factors[1].apply(base.shrink),
             gap: self.thresholds[0].apply(base.gap),
             merge: self.thresholds[1].apply(base.merge),
-            terminal: crate::Terminal {
+            terminal: liemesh::Terminal {
                 max_radius: self.terminal[0].apply(base.terminal.max_radius),
                 bounding_box: self.terminal[1].apply(base.terminal.bounding_box),
                 close: self.close.unwrap_or(base.terminal.close),
@@ -322,7 +341,7 @@ impl MesherInput {
     }
 }
 
-/// Target (a): decodes a [`MesherInput`], runs [`crate::run`] in `f64` and checks the result
+/// Target (a): decodes a [`MesherInput`], runs [`liemesh::run`] in `f64` and checks the result
 /// with [`check_run`]. Invalid invariant numbers must be rejected by
 /// [`Invariant::from_numbers`] exactly when they are not 6, 12 or 18 finite numbers.
 pub fn mesher(data: &[u8]) -> Result<(), Violation> {
@@ -354,7 +373,7 @@ pub fn mesher(data: &[u8]) -> Result<(), Violation> {
     );
     let params = input.params();
     let field = LieField::<f64>::new(&invariant);
-    let result = crate::run(&field, &params);
+    let result = liemesh::run(&field, &params);
     check_run(&field, &params, &result).map_err(|v| Violation(format!("{v}\ninput: {input:?}")))
 }
 
@@ -442,7 +461,7 @@ pub fn check_run(
         let over = (run.mesh.triangles.iter())
             .filter(|t| {
                 let corners = t.map(|i| run.mesh.vertices[i as usize]);
-                crate::quality::face_error_deg(corners, |c| field.normal(c)) > limit.to_degrees()
+                liemesh::quality::face_error_deg(corners, |c| field.normal(c)) > limit.to_degrees()
             })
             .count();
         ensure!(
@@ -898,7 +917,7 @@ impl TriangulateInput {
                 let mut params = p.params();
                 params.budget.max_points = 16 + 2 * *points as usize;
                 let field = LieField::<f64>::new(&p.invariant());
-                crate::sample::sample(&field, &params).expect("presets sample")
+                liemesh::sample::sample(&field, &params).expect("presets sample")
             }
             SamplesInput::Synthetic {
                 points,
@@ -1065,7 +1084,7 @@ pub fn triangulate(data: &[u8]) -> Result<(), Violation> {
         return Ok(());
     };
     let samples = input.samples();
-    let result = crate::triangulate::triangulate(&samples, input.close, input.improve);
+    let result = liemesh::triangulate::triangulate(&samples, input.close, input.improve);
     check_triangulation(&samples, &result).map_err(|v| Violation(format!("{v}\ninput: {input:?}")))
 }
 
@@ -1126,8 +1145,11 @@ pub fn check_triangulation(
 // ---------------------------------------------------------------------------------------------
 
 /// Target (c): the bytes as an invariant file (when they are UTF-8), as a PLY file and as an
-/// OBJ file; see [`check_invariant_file`] and [`check_read_mesh`].
+/// OBJ file; see `check_invariant_file` and [`check_read_mesh`]. The invariant-file part needs
+/// liemesh's `toml` feature (this crate's `toml` feature, on by default, turns it on; in the
+/// main crate's tests it is liemesh's own feature).
 pub fn invariant_file(data: &[u8]) -> Result<(), Violation> {
+    #[cfg(feature = "toml")]
     if let Ok(text) = std::str::from_utf8(data) {
         let path = Path::new("fuzz.toml");
         check_invariant_file(&InvariantFile::parse(text, path), "fuzz.toml")?;
@@ -1140,6 +1162,7 @@ pub fn invariant_file(data: &[u8]) -> Result<(), Violation> {
 /// Checks a parsed invariant file: a valid one has 6 or 18 finite numbers that rebuild the
 /// same invariant and a patch that applies to the default parameters; an error message is one
 /// non-empty line naming the file.
+#[cfg(feature = "toml")]
 pub fn check_invariant_file(
     result: &Result<InvariantFile, InvariantFileError>,
     file_name: &str,
@@ -1187,7 +1210,7 @@ pub enum MeshFileKind {
 /// reads back bit-identically (PLY in binary and ASCII, OBJ), or an error with a message.
 pub fn check_read_mesh(
     kind: MeshFileKind,
-    result: &Result<Mesh, crate::io::IoError>,
+    result: &Result<Mesh, liemesh::io::IoError>,
 ) -> Result<(), Violation> {
     let mesh = match result {
         Err(e) => {
