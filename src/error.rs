@@ -89,4 +89,14 @@ pub enum MeshError {
     /// The samples could not be triangulated (too few points, all points collinear in the chart…).
     #[error("could not triangulate the samples: {0}")]
     Triangulation(String),
+    /// No triangle survived: every face the samples gave was removed as crossing another
+    /// or as part of a component apart from `p0`'s.
+    #[error(
+        "no triangle of the {points} sample points survived validation (the swept surface \
+         folds onto itself right at p0); try another p0 or smaller steps (dt, beta_max)"
+    )]
+    Empty {
+        /// How many points the curves laid.
+        points: usize,
+    },
 }

@@ -36,7 +36,7 @@
 //!
 //! A program that only meshes depends on `liemesh = { version = "0.1", default-features =
 //! false }`: the mesher, the model, the scalars, quality measures, audits and the PLY, OBJ and
-//! STL writers and readers, on num-traits, nalgebra, spade, thiserror and rustc-hash.
+//! STL writers and readers, on num-traits, nalgebra, spade, robust, thiserror and rustc-hash.
 #![warn(missing_docs)]
 #![deny(rustdoc::broken_intra_doc_links)]
 
@@ -58,7 +58,7 @@ pub mod triangulate;
 pub use error::MeshError;
 pub use mesh::{Mesh, Provenance};
 pub use model::NormalField;
-pub use params::{Budget, MeshParams, Method, Mode, Terminal};
+pub use params::{Angle, MeshParams, Method, Mode, Resolved, Scales};
 
 // The fuzz targets' checks (`fuzz/src/lib.rs`, written against the public API as
 // `liemesh::...`), compiled into the unit tests too.
@@ -95,8 +95,55 @@ pub struct MeshRun<T> {
     pub untangled: triangulate::Untangled,
     /// The mesh's validation (always valid: an invalid mesh is an error).
     pub validation: mesh::Validation,
+    /// The parameters with their automatic values worked out.
+    pub params: Resolved,
     /// How long each stage took.
     pub timings: Timings,
+}
+
+impl<T> MeshRun<T> {
+    /// The budgets that cut the run short, each in words (empty when none did): the mesh is
+    /// then valid but smaller than the terminal conditions alone would have made it.
+    pub fn cut_short(&self) -> Vec<String> {
+        let p = &self.params;
+        let mut why = Vec::new();
+        if self.samples.hit_point_budget {
+            why.push(format!(
+                "the point budget (max_points = {}) ran out",
+                p.max_points
+            ));
+        }
+        if self.samples.curves.len() >= p.max_curves {
+            why.push(format!(
+                "the curve budget (max_curves = {}) stopped insertions",
+                p.max_curves
+            ));
+        }
+        let ends = self.samples.ends();
+        if ends.budget > 0 && !self.samples.hit_point_budget {
+            why.push(format!(
+                "{} curve{} ended on a budget (max_steps = {} steps per curve, or no chord \
+                 within max_retries = {} Newton iterations)",
+                ends.budget,
+                if ends.budget == 1 { "" } else { "s" },
+                p.max_steps,
+                p.max_retries
+            ));
+        }
+        if self.stitched.budget_hit {
+            why.push("the stitching of meeting fronts ran out of its operation budget".into());
+        }
+        if let Some(r) = &self.refinement {
+            if r.over_limit > 0 {
+                why.push(format!(
+                    "refinement left {} face{} over the normal-error bound",
+                    r.over_limit,
+                    if r.over_limit == 1 { "" } else { "s" }
+                ));
+            }
+        }
+        why
+    }
 }
 
 /// Wall-clock seconds each stage of [`run`] took.
@@ -133,10 +180,12 @@ pub fn run<T: Scalar, F: NormalField<T>>(
         *since = now;
     };
     let mut since = 0.0;
-    let samples = sample::sample(field, params)?;
+    let resolved = params.resolve::<T, F>(field)?;
+    let params = &resolved;
+    let samples = sample::sample_resolved(field, params)?;
     lap(&mut timings.sampling, &mut since);
     let improve = params.mode == Mode::Default;
-    let (mut mesh, chart) = triangulate::triangulate(&samples, params.terminal.close, improve)?;
+    let (mut mesh, chart) = triangulate::triangulate(&samples, params.close, improve)?;
     // The mesh's vertices in the working precision, found by provenance.
     let mut vertices: Vec<scalar::Vec3<T>> = mesh
         .provenance
@@ -146,11 +195,11 @@ pub fn run<T: Scalar, F: NormalField<T>>(
                 .clone()
         })
         .collect();
-    let stitched = params
-        .terminal
-        .close
-        .then(|| triangulate::stitch(field, params, &samples, &mut mesh, &mut vertices))
-        .unwrap_or_default();
+    let stitched = if params.close {
+        triangulate::stitch(field, params, &samples, &mut mesh, &mut vertices)
+    } else {
+        Default::default()
+    };
     lap(&mut timings.triangulating, &mut since);
     // Where every vertex was before relaxation: a relaxation move that makes faces cross is
     // taken back.
@@ -163,11 +212,14 @@ pub fn run<T: Scalar, F: NormalField<T>>(
         triangulate::relax(field, params, &mut mesh, &mut vertices);
     }
     lap(&mut timings.improving, &mut since);
-    let refinement = params.max_normal_error.map(|limit| {
-        triangulate::refine(field, params, limit.to_degrees(), &mut mesh, &mut vertices)
-    });
+    let refinement = params
+        .max_normal_error
+        .map(|limit| triangulate::refine(field, params, limit.degrees(), &mut mesh, &mut vertices));
     lap(&mut timings.refining, &mut since);
     // Validation, decided exactly; crossings are undone (see `triangulate::untangle`).
+    // Fans that meet only at a vertex are cut apart first: p0's component is then a
+    // manifold through its vertices as well as its edges.
+    triangulate::unpinch(&mut mesh.triangles);
     triangulate::keep_main_component(&mut mesh);
     let mut validation = mesh.validate();
     let mut untangled = triangulate::Untangled::default();
@@ -178,9 +230,19 @@ pub fn run<T: Scalar, F: NormalField<T>>(
         validation = mesh.validate();
     }
     triangulate::drop_unused(&mut mesh, &mut vertices);
+    // The refinement's count of faces over the bound, on the mesh as returned.
+    let mut refinement = refinement;
+    if let (Some(r), Some(limit)) = (refinement.as_mut(), params.max_normal_error) {
+        r.over_limit = triangulate::faces_over(field, &mesh, limit.degrees());
+    }
     lap(&mut timings.validating, &mut since);
     if !validation.is_valid() {
         return Err(MeshError::Invalid(Box::new(validation)));
+    }
+    if mesh.triangles.is_empty() {
+        return Err(MeshError::Empty {
+            points: samples.points.len(),
+        });
     }
     Ok(MeshRun {
         samples,
@@ -191,6 +253,7 @@ pub fn run<T: Scalar, F: NormalField<T>>(
         stitched,
         untangled,
         validation,
+        params: resolved,
         timings,
     })
 }

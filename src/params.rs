@@ -1,24 +1,83 @@
-//! Mesher parameters: everything the paper's Step 1 sets, plus terminal conditions and budgets.
+//! Mesher parameters: one flat set, defined once, that the library, the invariant file's
+//! `[mesh]` table, the command line's flags and the JSON report all read and write.
+//!
+//! Lengths that depend on the surface (the steps, the geodesic radius, the bounding box) and
+//! the initial direction are automatic unless given: [`MeshParams::resolve`] works them out
+//! from the surface's size and curvature at `p0` ([`Scales`]), so that the same surface
+//! meshes the same way at any scale. Angles are [`Angle`]s, read and written in degrees.
 
 use crate::error::MeshError;
+use crate::model::{least_aligned_tangent, LocalShape, NormalField, INTEGRABLE_DEFECT};
+use crate::scalar::Scalar;
+
+/// An angle. Kept in radians; read and written in degrees wherever a person sees it (files,
+/// the command line, reports).
+#[derive(Clone, Copy, Debug, Default, PartialEq, PartialOrd)]
+pub struct Angle(f64);
+
+impl Angle {
+    /// The angle of `degrees` degrees.
+    pub fn from_degrees(degrees: f64) -> Angle {
+        Angle(degrees.to_radians())
+    }
+    /// The angle of `radians` radians.
+    pub const fn from_radians(radians: f64) -> Angle {
+        Angle(radians)
+    }
+    /// In degrees.
+    pub fn degrees(self) -> f64 {
+        self.0.to_degrees()
+    }
+    /// In radians.
+    pub const fn radians(self) -> f64 {
+        self.0
+    }
+}
+
+impl std::ops::Mul<f64> for Angle {
+    type Output = Angle;
+    fn mul(self, k: f64) -> Angle {
+        Angle(self.0 * k)
+    }
+}
+
+impl std::ops::Div<f64> for Angle {
+    type Output = Angle;
+    fn div(self, k: f64) -> Angle {
+        Angle(self.0 / k)
+    }
+}
+
+#[cfg(feature = "serde")]
+impl serde::Serialize for Angle {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        s.serialize_f64(self.degrees())
+    }
+}
+
+#[cfg(feature = "serde")]
+impl<'de> serde::Deserialize<'de> for Angle {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Angle, D::Error> {
+        f64::deserialize(d).map(Angle::from_degrees)
+    }
+}
 
 /// How curves are laid out (DESIGN.md §2).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
-#[cfg_attr(feature = "serde", serde(rename_all = "lowercase", tag = "kind"))]
+#[cfg_attr(feature = "serde", serde(rename_all = "lowercase"))]
 pub enum Method {
-    /// The previous method (paper refs \[5\]\[6\]): `curves` curves at uniform angles, no insertion.
-    Previous {
-        /// Number of curves leaving `p0`.
-        curves: usize,
-    },
     /// The proposed method: the Step 2 fan (first points at least Δt apart) and Step 6
     /// insertion of new curves where neighbouring curves diverge.
+    #[default]
     Proposed,
+    /// The previous method (paper refs \[5\]\[6\]): [`MeshParams::curves`] curves at uniform
+    /// angles, no insertion.
+    Previous,
 }
 
 /// How one step is taken.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 #[cfg_attr(feature = "serde", serde(rename_all = "lowercase"))]
 pub enum Mode {
@@ -33,114 +92,256 @@ pub enum Mode {
     Default,
 }
 
-/// When a curve ends (the paper's Step 7), besides budgets and singular points.
-#[derive(Clone, Copy, Debug, PartialEq)]
-#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
-pub struct Terminal {
-    /// Largest arc length from `p0` along a curve.
-    pub max_radius: f64,
-    /// Half-size of the axis-aligned box around the origin that points must stay in.
-    pub bounding_box: f64,
-    /// End a curve when it runs into points that other curves laid down (closed surfaces),
-    /// and close the remaining hole with a second chart.
-    pub close: bool,
-}
-
-impl Default for Terminal {
-    fn default() -> Self {
-        Terminal {
-            max_radius: 10.0,
-            bounding_box: 100.0,
-            close: true,
-        }
-    }
-}
-
-/// Hard limits on every loop.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
-pub struct Budget {
-    /// Most sample points in total.
-    pub max_points: usize,
-    /// Most curves (initial and inserted).
-    pub max_curves: usize,
-    /// Most accepted steps on one curve.
-    pub max_steps_per_curve: usize,
-    /// Most Δt retries within one step (paper mode), or Newton iterations for one chord
-    /// (default mode, clamped to 4..=64; a chord that finds no root is retried at half the
-    /// length, up to [`CHORD_HALVINGS`](crate::trace::CHORD_HALVINGS) times).
-    pub max_retries: usize,
-}
-
-impl Default for Budget {
-    fn default() -> Self {
-        Budget {
-            max_points: 4_000_000,
-            max_curves: 200_000,
-            max_steps_per_curve: 100_000,
-            max_retries: 64,
-        }
-    }
-}
-
-/// All parameters of one meshing run. Angles are in radians.
+/// All parameters of one meshing run.
 ///
-/// The defaults are the fig3 preset's: see [`crate::preset`].
+/// `None` lengths and `w00` are automatic (see [`MeshParams::resolve`]). The defaults mesh
+/// any surface of the model, closed or not, at any scale: the proposed method, the default
+/// mode, β ∈ [4°, 8°], δ = 1.5, δ' = 0.6, insertion at 1.8 and merging at 0.7 steps.
+///
+/// ```
+/// use liemesh::{Angle, MeshParams};
+///
+/// let mut params = MeshParams::at([0.0, 0.0, 2.0]);
+/// params.beta_max = Angle::from_degrees(6.0);
+/// params.max_normal_error = Some(Angle::from_degrees(1.0));
+/// assert!(params.dt.is_none(), "Δt follows the surface unless given");
+/// ```
 #[derive(Clone, Debug, PartialEq)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(default, deny_unknown_fields))]
+#[non_exhaustive]
 pub struct MeshParams {
     /// Curve layout.
     pub method: Method,
+    /// Number of curves of the previous method (at least 3).
+    pub curves: usize,
     /// Step rule.
     pub mode: Mode,
     /// Initial point.
     pub p0: [f64; 3],
-    /// Initial direction (projected onto the tangent plane at `p0`).
-    pub w00: [f64; 3],
-    /// Initial step size Δt.
-    pub dt: f64,
-    /// Smallest step allowed (steps are clamped to `[dt_min, dt_max]`).
-    pub dt_min: f64,
-    /// Largest step allowed.
-    pub dt_max: f64,
-    /// β_min: smallest normal turn per step, radians.
-    pub beta_min: f64,
-    /// β_max: largest normal turn per step, radians.
-    pub beta_max: f64,
+    /// Initial direction (projected onto the tangent plane at `p0`); automatic: the
+    /// coordinate axis least aligned with the normal at `p0`.
+    pub w00: Option<[f64; 3]>,
+    /// Initial step Δt; automatic: a tenth of the step scale.
+    pub dt: Option<f64>,
+    /// Smallest step (steps are clamped to `[dt_min, dt_max]`); automatic: 10⁻³ step scales.
+    pub dt_min: Option<f64>,
+    /// Largest step; automatic: half the step scale.
+    pub dt_max: Option<f64>,
+    /// β_min: smallest normal turn per step.
+    #[cfg_attr(feature = "serde", serde(rename = "beta_min_deg"))]
+    pub beta_min: Angle,
+    /// β_max: largest normal turn per step.
+    #[cfg_attr(feature = "serde", serde(rename = "beta_max_deg"))]
+    pub beta_max: Angle,
     /// δ > 1: step growth when the normal turns less than β_min.
     pub grow: f64,
     /// δ' in (0, 1): step shrink when it turns more than β_max.
     pub shrink: f64,
-    /// Insert a curve when neighbouring curves are more than `gap` × the local step apart
-    /// (proposed method).
+    /// Insert a curve when neighbouring curves are more than `gap` × the local step apart, or
+    /// their normals more than `gap` × β_max (proposed method).
     pub gap: f64,
     /// End a curve when it comes closer than `merge` × the local step to a neighbour
-    /// (proposed method; must be below `gap / 2` so that inserting and merging cannot chase
-    /// each other).
+    /// (proposed method; below `gap / 2` so that inserting and merging cannot chase each
+    /// other).
     pub merge: f64,
-    /// Terminal conditions.
-    pub terminal: Terminal,
-    /// Budgets.
-    pub budget: Budget,
+    /// Largest arc length from `p0` along a curve; automatic: 4π extent scales.
+    pub max_radius: Option<f64>,
+    /// Half-size of the axis-aligned box around the origin that points stay in; automatic: 6
+    /// extent scales.
+    pub bounding_box: Option<f64>,
+    /// End curves that run onto the surface other curves swept, and stitch the fronts where
+    /// they meet (closing closed surfaces).
+    pub close: bool,
+    /// Most sample points (and mesh vertices) in total.
+    pub max_points: usize,
+    /// Most curves (initial and inserted).
+    pub max_curves: usize,
+    /// Most accepted steps on one curve.
+    pub max_steps: usize,
+    /// Most Δt retries within one step (paper mode), or Newton iterations for one chord
+    /// (default mode, clamped to 4..=64; a chord that finds no root is retried at half the
+    /// length, up to [`CHORD_HALVINGS`](crate::trace::CHORD_HALVINGS) times).
+    pub max_retries: usize,
     /// Refinement: split faces whose normal error (the angle between the face and the field
-    /// normal at its centroid) exceeds this many radians, after the mesh is built. `None`
-    /// (the presets' choice) leaves the mesh as built.
+    /// normal at its centroid) exceeds this, after the mesh is built. `None` leaves the mesh
+    /// as built.
     #[cfg_attr(
         feature = "serde",
-        serde(default, skip_serializing_if = "Option::is_none")
+        serde(
+            rename = "max_normal_error_deg",
+            skip_serializing_if = "Option::is_none"
+        )
     )]
-    pub max_normal_error: Option<f64>,
+    pub max_normal_error: Option<Angle>,
 }
 
 impl Default for MeshParams {
     fn default() -> Self {
-        crate::preset::Preset::Fig3.params()
+        MeshParams {
+            method: Method::Proposed,
+            curves: 15,
+            mode: Mode::Default,
+            p0: [0.0, 0.0, 1.0],
+            w00: None,
+            dt: None,
+            dt_min: None,
+            dt_max: None,
+            beta_min: Angle::from_degrees(4.0),
+            beta_max: Angle::from_degrees(8.0),
+            grow: 1.5,
+            shrink: 0.6,
+            gap: 1.8,
+            merge: 0.7,
+            max_radius: None,
+            bounding_box: None,
+            close: true,
+            max_points: 2_000_000,
+            max_curves: 200_000,
+            max_steps: 100_000,
+            max_retries: 64,
+            max_normal_error: None,
+        }
     }
 }
 
+/// The two lengths the automatic parameters are measured in, from the surface at `p0`.
+///
+/// With `ρ` the radius of curvature in the most curved direction at `p0` (`1/|κ|max`):
+/// - the **extent** scale `max(|p0|, ρ/4)` sizes the terminal conditions (a surface of the
+///   model is centred at the origin, so `|p0|` is about its size; where `p0` is near the
+///   origin, the curvature sizes it; a quarter of `ρ`, because the flat side of an elongated
+///   quadric curves far less than its size suggests);
+/// - the **step** scale `max(ρ, extent / 8)` sizes the steps (the curvature sets them; the
+///   floor keeps a sharp tip, such as an elongated ellipsoid's, from shrinking the steps
+///   everywhere else).
+///
+/// On a sphere of radius `r` both are `r`: the mesh is the same at every scale.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+pub struct Scales {
+    /// Sizes the geodesic radius and the bounding box.
+    pub extent: f64,
+    /// Sizes Δt and its clamps.
+    pub step: f64,
+}
+
+impl Scales {
+    /// The scales of the surface whose local shape at `p0` is `shape`.
+    pub fn of(p0: [f64; 3], shape: &LocalShape) -> Scales {
+        let rho = shape.radius_of_curvature();
+        let r0 = (p0[0] * p0[0] + p0[1] * p0[1] + p0[2] * p0[2]).sqrt();
+        let extent = match (r0 > 0.0, rho.is_finite()) {
+            (true, true) => r0.max(rho / 4.0),
+            (true, false) => r0,
+            (false, true) => rho,
+            (false, false) => 1.0,
+        };
+        let step = if rho.is_finite() {
+            rho.max(extent / 8.0)
+        } else {
+            extent
+        };
+        Scales { extent, step }
+    }
+}
+
+/// The parameters of one run with every automatic value worked out: what the stages read.
+#[derive(Clone, Debug, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[non_exhaustive]
+pub struct Resolved {
+    /// The parameters as given (not in the serialised form, which lists the worked-out
+    /// values beside them).
+    #[cfg_attr(feature = "serde", serde(skip))]
+    pub given: MeshParams,
+    /// The surface's scales at `p0`.
+    pub scales: Scales,
+    /// Initial direction.
+    pub w00: [f64; 3],
+    /// Initial step.
+    pub dt: f64,
+    /// Smallest step.
+    pub dt_min: f64,
+    /// Largest step.
+    pub dt_max: f64,
+    /// Largest geodesic radius.
+    pub max_radius: f64,
+    /// Bounding box half-size.
+    pub bounding_box: f64,
+}
+
+impl std::ops::Deref for Resolved {
+    type Target = MeshParams;
+    fn deref(&self) -> &MeshParams {
+        &self.given
+    }
+}
+
+/// Factors of the automatic lengths: Δt, dt_min, dt_max (of the step scale), max_radius and
+/// bounding_box (of the extent scale).
+const AUTO_DT: f64 = 0.1;
+const AUTO_DT_MIN: f64 = 1e-3;
+const AUTO_DT_MAX: f64 = 0.5;
+const AUTO_RADIUS: f64 = 4.0 * std::f64::consts::PI;
+/// The automatic geodesic radius on a non-integrable field, of the extent scale: a
+/// hemisphere's. No surface has such a normal field; the surface the curves sweep folds onto
+/// itself within about this radius, and what lies beyond is laid only to be cut away.
+const AUTO_RADIUS_SWEPT: f64 = std::f64::consts::PI;
+const AUTO_BOX: f64 = 6.0;
+
 impl MeshParams {
-    /// Checks every parameter; the error says which one is wrong and what is allowed.
-    pub fn validate(&self) -> Result<(), MeshError> {
+    /// The defaults, from `p0`.
+    pub fn at(p0: [f64; 3]) -> MeshParams {
+        MeshParams {
+            p0,
+            ..MeshParams::default()
+        }
+    }
+
+    /// Works out the automatic values for `field` (see [`Scales`]) and checks every parameter;
+    /// the error says which one is wrong and what is allowed.
+    pub fn resolve<T: Scalar, F: NormalField<T> + ?Sized>(
+        &self,
+        field: &F,
+    ) -> Result<Resolved, MeshError> {
+        self.check()?;
+        let Some(shape) = LocalShape::at::<T, F>(field, self.p0) else {
+            let v = field
+                .normal(&crate::scalar::Vec3::from_f64(self.p0))
+                .to_f64();
+            return Err(MeshError::SingularInitialPoint {
+                p0: self.p0,
+                normal: v,
+            });
+        };
+        let scales = Scales::of(self.p0, &shape);
+        let w00 = match self.w00 {
+            Some(w) => w,
+            None => least_aligned_tangent(shape.normal),
+        };
+        let resolved = Resolved {
+            given: self.clone(),
+            scales,
+            w00,
+            dt: self.dt.unwrap_or(AUTO_DT * scales.step),
+            dt_min: self.dt_min.unwrap_or(AUTO_DT_MIN * scales.step),
+            dt_max: self.dt_max.unwrap_or(AUTO_DT_MAX * scales.step),
+            max_radius: self.max_radius.unwrap_or(
+                if shape.integrability_defect < INTEGRABLE_DEFECT {
+                    AUTO_RADIUS
+                } else {
+                    AUTO_RADIUS_SWEPT
+                } * scales.extent,
+            ),
+            bounding_box: self.bounding_box.unwrap_or(AUTO_BOX * scales.extent),
+        };
+        resolved.check_lengths()?;
+        Ok(resolved)
+    }
+
+    /// Checks every parameter that does not depend on the surface.
+    fn check(&self) -> Result<(), MeshError> {
         let finite = |name: &'static str, value: f64| {
             if value.is_finite() {
                 Ok(())
@@ -151,53 +352,37 @@ impl MeshParams {
         for (i, &x) in self.p0.iter().enumerate() {
             finite(["p0.x", "p0.y", "p0.z"][i], x)?;
         }
-        for (i, &x) in self.w00.iter().enumerate() {
-            finite(["w00.x", "w00.y", "w00.z"][i], x)?;
+        if let Some(w) = self.w00 {
+            for (i, &x) in w.iter().enumerate() {
+                finite(["w00.x", "w00.y", "w00.z"][i], x)?;
+            }
         }
         for (name, v) in [
             ("dt", self.dt),
             ("dt_min", self.dt_min),
             ("dt_max", self.dt_max),
-            ("beta_min", self.beta_min),
-            ("beta_max", self.beta_max),
+            ("max_radius", self.max_radius),
+            ("bounding_box", self.bounding_box),
+        ] {
+            if let Some(v) = v {
+                finite(name, v)?;
+            }
+        }
+        for (name, v) in [
+            ("beta_min_deg", self.beta_min.degrees()),
+            ("beta_max_deg", self.beta_max.degrees()),
             ("grow", self.grow),
             ("shrink", self.shrink),
             ("gap", self.gap),
             ("merge", self.merge),
-            ("max_radius", self.terminal.max_radius),
-            ("bounding_box", self.terminal.bounding_box),
         ] {
             finite(name, v)?;
         }
-        if self.dt <= 0.0 {
-            return Err(MeshError::StepSize {
-                name: "dt",
-                value: self.dt,
-                why: "Δt must be greater than 0",
-            });
-        }
-        if self.dt_min <= 0.0 {
-            return Err(MeshError::StepSize {
-                name: "dt_min",
-                value: self.dt_min,
-                why: "the smallest step must be greater than 0",
-            });
-        }
-        if self.dt_max < self.dt_min {
-            return Err(MeshError::StepSize {
-                name: "dt_max",
-                value: self.dt_max,
-                why: "the largest step must not be below dt_min",
-            });
-        }
-        let deg = |r: f64| r.to_degrees();
-        if !(self.beta_min > 0.0
-            && self.beta_min < self.beta_max
-            && self.beta_max < std::f64::consts::FRAC_PI_2)
-        {
+        let (bmin, bmax) = (self.beta_min.radians(), self.beta_max.radians());
+        if !(bmin > 0.0 && bmin < bmax && bmax < std::f64::consts::FRAC_PI_2) {
             return Err(MeshError::AngleBand {
-                min_deg: deg(self.beta_min),
-                max_deg: deg(self.beta_max),
+                min_deg: self.beta_min.degrees(),
+                max_deg: self.beta_max.degrees(),
             });
         }
         if self.grow <= 1.0 {
@@ -221,53 +406,83 @@ impl MeshParams {
             });
         }
         if let Some(e) = self.max_normal_error {
-            finite("max_normal_error", e)?;
-            if !(e > 0.0 && e < std::f64::consts::FRAC_PI_2) {
+            finite("max_normal_error_deg", e.degrees())?;
+            if !(e.radians() > 0.0 && e.radians() < std::f64::consts::FRAC_PI_2) {
                 return Err(MeshError::OutOfRange {
                     name: "max_normal_error_deg",
-                    value: e.to_degrees(),
+                    value: e.degrees(),
                     why: "the bound on the face-normal error must lie strictly between 0° and 90°",
                 });
             }
         }
-        if self.terminal.max_radius <= 0.0 {
-            return Err(MeshError::OutOfRange {
-                name: "max_radius",
-                value: self.terminal.max_radius,
-                why: "the largest geodesic radius must be greater than 0",
-            });
-        }
-        if self.terminal.bounding_box <= 0.0 {
-            return Err(MeshError::OutOfRange {
-                name: "bounding_box",
-                value: self.terminal.bounding_box,
-                why: "the bounding box half-size must be greater than 0",
-            });
-        }
-        let b = &self.budget;
         for (name, v) in [
-            ("max_points", b.max_points),
-            ("max_curves", b.max_curves),
-            ("max_steps_per_curve", b.max_steps_per_curve),
-            ("max_retries", b.max_retries),
+            ("max_points", self.max_points),
+            ("max_curves", self.max_curves),
+            ("max_steps", self.max_steps),
+            ("max_retries", self.max_retries),
         ] {
             if v == 0 {
                 return Err(MeshError::ZeroBudget(name));
             }
         }
         let fan = match self.method {
-            Method::Previous { curves } if curves < 3 => {
-                return Err(MeshError::TooFewCurves(curves))
+            Method::Previous if self.curves < 3 => {
+                return Err(MeshError::TooFewCurves(self.curves))
             }
-            Method::Previous { curves } => curves,
+            Method::Previous => self.curves,
             Method::Proposed => 6,
         };
-        if b.max_curves < fan {
+        if self.max_curves < fan {
             return Err(MeshError::OutOfRange {
                 name: "max_curves",
-                value: b.max_curves as f64,
+                value: self.max_curves as f64,
                 why: "the curve budget must allow the initial fan (6 curves for the proposed \
                       method, `curves` for the previous one)",
+            });
+        }
+        Ok(())
+    }
+}
+
+impl Resolved {
+    /// Checks the lengths (given or automatic).
+    // `!(x > 0.0)` on purpose: NaN fails the test too.
+    #[allow(clippy::neg_cmp_op_on_partial_ord)]
+    fn check_lengths(&self) -> Result<(), MeshError> {
+        let auto = |given: Option<f64>| given.is_none();
+        let bad = |name: &'static str, value: f64, why: &'static str| {
+            Err(MeshError::StepSize { name, value, why })
+        };
+        if !(self.dt > 0.0) {
+            return bad("dt", self.dt, "Δt must be greater than 0");
+        }
+        if !(self.dt_min > 0.0) {
+            return bad(
+                "dt_min",
+                self.dt_min,
+                "the smallest step must be greater than 0",
+            );
+        }
+        if !(self.dt_max >= self.dt_min) {
+            let why = if auto(self.given.dt_max) {
+                "the automatic largest step is below the dt_min given; give dt_max too"
+            } else {
+                "the largest step must not be below dt_min"
+            };
+            return bad("dt_max", self.dt_max, why);
+        }
+        if !(self.max_radius > 0.0) {
+            return Err(MeshError::OutOfRange {
+                name: "max_radius",
+                value: self.max_radius,
+                why: "the largest geodesic radius must be greater than 0",
+            });
+        }
+        if !(self.bounding_box > 0.0) {
+            return Err(MeshError::OutOfRange {
+                name: "bounding_box",
+                value: self.bounding_box,
+                why: "the bounding box half-size must be greater than 0",
             });
         }
         Ok(())

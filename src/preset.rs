@@ -18,7 +18,7 @@
 //! to [0.001, 1], insertion at 1.8 steps, merging at 0.7 steps.
 
 use crate::model::Invariant;
-use crate::params::{Budget, MeshParams, Method, Mode, Terminal};
+use crate::params::{MeshParams, Method, Mode};
 
 /// Table 2, Fig. 1–3: `A = I`, `B = C = 0` — the unit sphere.
 pub const SPHERE_INVARIANT: [f64; 18] = [
@@ -96,35 +96,26 @@ impl Preset {
         Invariant::from_numbers(numbers).expect("Table 2 invariants are valid")
     }
 
-    /// The mesher parameters of the figure.
+    /// The mesher parameters of the figure (every length explicit, as in the paper).
     pub fn params(self) -> MeshParams {
-        let method = match self {
-            Preset::Fig1 | Preset::Fig4 => Method::Previous { curves: 15 },
-            Preset::Fig2 | Preset::Fig5 => Method::Previous { curves: 40 },
-            Preset::Fig3 | Preset::Fig6 => Method::Proposed,
+        let (method, curves) = match self {
+            Preset::Fig1 | Preset::Fig4 => (Method::Previous, 15),
+            Preset::Fig2 | Preset::Fig5 => (Method::Previous, 40),
+            Preset::Fig3 | Preset::Fig6 => (Method::Proposed, 15),
         };
         let sphere = matches!(self, Preset::Fig1 | Preset::Fig2 | Preset::Fig3);
         MeshParams {
             method,
+            curves,
             mode: Mode::Default,
             p0: if sphere { [0.0, 0.0, 1.0] } else { FIG46_P0 },
-            w00: [1.0, 0.0, 0.0],
-            dt: 0.1,
-            dt_min: 0.001,
-            dt_max: 1.0,
-            beta_min: 4f64.to_radians(),
-            beta_max: 8f64.to_radians(),
-            grow: 1.5,
-            shrink: 0.6,
-            gap: 1.8,
-            merge: 0.7,
-            terminal: Terminal {
-                max_radius: if sphere { 10.0 } else { FIG46_RADIUS },
-                bounding_box: 10.0,
-                close: true,
-            },
-            budget: Budget::default(),
-            max_normal_error: None,
+            w00: Some([1.0, 0.0, 0.0]),
+            dt: Some(0.1),
+            dt_min: Some(0.001),
+            dt_max: Some(1.0),
+            max_radius: Some(if sphere { 10.0 } else { FIG46_RADIUS }),
+            bounding_box: Some(10.0),
+            ..MeshParams::default()
         }
     }
 }

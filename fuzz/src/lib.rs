@@ -31,7 +31,7 @@ use liemesh::sample::{Curve, CurveEnd, Samples, StepRecord};
 use liemesh::scalar::Vec3;
 use liemesh::trace::StepLimit;
 use liemesh::triangulate::{ChartTriangulation, Mesh, Provenance};
-use liemesh::{Budget, MeshError, MeshParams, MeshRun, Method, Mode, NormalField};
+use liemesh::{Angle, MeshError, MeshParams, MeshRun, Method, Mode, NormalField, Resolved};
 use std::collections::{HashMap, HashSet};
 use std::fmt;
 #[cfg(feature = "toml")]
@@ -215,27 +215,31 @@ pub enum BudgetInput {
 }
 
 impl BudgetInput {
-    /// The budget.
-    pub fn budget(self) -> Budget {
+    /// The budgets: `(max_points, max_curves, max_steps, max_retries)`.
+    pub fn budgets(self) -> (usize, usize, usize, usize) {
         match self {
-            BudgetInput::Small => Budget {
-                max_points: FUZZ_MAX_POINTS,
-                max_curves: 120,
-                max_steps_per_curve: 200,
-                max_retries: 64,
-            },
+            BudgetInput::Small => (FUZZ_MAX_POINTS, 120, 200, 64),
             BudgetInput::Custom {
                 points,
                 curves,
                 steps,
                 retries,
-            } => Budget {
-                max_points: points as usize % (FUZZ_MAX_POINTS + 1),
-                max_curves: curves as usize % 129,
-                max_steps_per_curve: steps as usize % 401,
-                max_retries: retries as usize % 65,
-            },
+            } => (
+                points as usize % (FUZZ_MAX_POINTS + 1),
+                curves as usize % 129,
+                steps as usize % 401,
+                retries as usize % 65,
+            ),
         }
+    }
+
+    /// Sets the budgets of `params`.
+    pub fn apply(self, params: &mut MeshParams) {
+        let (points, curves, steps, retries) = self.budgets();
+        params.max_points = points;
+        params.max_curves = curves;
+        params.max_steps = steps;
+        params.max_retries = retries;
     }
 }
 
@@ -306,38 +310,44 @@ impl MesherInput {
         }
     }
 
-    /// The parameters.
+    /// The parameters. The presets give every length and `w00`, so each is derived from the
+    /// preset's value; a length a preset left automatic would stay automatic.
     pub fn params(&self) -> MeshParams {
         let base = self.base().params();
         let n3 = |n: [Num; 3], b: [f64; 3]| [n[0].apply(b[0]), n[1].apply(b[1]), n[2].apply(b[2])];
-        MeshParams {
-            method: match self.method {
-                MethodInput::Preset => base.method,
-                MethodInput::Proposed => Method::Proposed,
-                MethodInput::Previous(c) => Method::Previous { curves: c as usize },
-            },
-            mode: if self.paper { Mode::Paper } else { base.mode },
-            p0: n3(self.p0, base.p0),
-            w00: n3(self.w00, base.w00),
-            dt: self.steps[0].apply(base.dt),
-            dt_min: self.steps[1].apply(base.dt_min),
-            dt_max: self.steps[2].apply(base.dt_max),
-            beta_min: self.band[0].apply(base.beta_min),
-            beta_max: self.band[1].apply(base.beta_max),
-            grow: self.factors[0].apply(base.grow),
-            shrink: self.factors[1].apply(base.shrink),
-            gap: self.thresholds[0].apply(base.gap),
-            merge: self.thresholds[1].apply(base.merge),
-            terminal: liemesh::Terminal {
-                max_radius: self.terminal[0].apply(base.terminal.max_radius),
-                bounding_box: self.terminal[1].apply(base.terminal.bounding_box),
-                close: self.close.unwrap_or(base.terminal.close),
-            },
-            budget: self.budget.budget(),
-            max_normal_error: self
-                .refine
-                .map(|n| n.apply(FUZZ_NORMAL_ERROR_DEG.to_radians())),
+        let opt = |n: Num, b: Option<f64>| b.map(|b| n.apply(b));
+        let angle = |n: Num, b: Angle| Angle::from_radians(n.apply(b.radians()));
+        let mut p = base.clone();
+        match self.method {
+            MethodInput::Preset => {}
+            MethodInput::Proposed => p.method = Method::Proposed,
+            MethodInput::Previous(c) => {
+                p.method = Method::Previous;
+                p.curves = c as usize;
+            }
         }
+        if self.paper {
+            p.mode = Mode::Paper;
+        }
+        p.p0 = n3(self.p0, base.p0);
+        p.w00 = base.w00.map(|w| n3(self.w00, w));
+        p.dt = opt(self.steps[0], base.dt);
+        p.dt_min = opt(self.steps[1], base.dt_min);
+        p.dt_max = opt(self.steps[2], base.dt_max);
+        p.beta_min = angle(self.band[0], base.beta_min);
+        p.beta_max = angle(self.band[1], base.beta_max);
+        p.grow = self.factors[0].apply(base.grow);
+        p.shrink = self.factors[1].apply(base.shrink);
+        p.gap = self.thresholds[0].apply(base.gap);
+        p.merge = self.thresholds[1].apply(base.merge);
+        p.max_radius = opt(self.terminal[0], base.max_radius);
+        p.bounding_box = opt(self.terminal[1], base.bounding_box);
+        p.close = self.close.unwrap_or(base.close);
+        self.budget.apply(&mut p);
+        p.max_normal_error = self
+            .refine
+            .map(|n| Angle::from_radians(n.apply(FUZZ_NORMAL_ERROR_DEG.to_radians())));
+        p
     }
 }
 
@@ -379,15 +389,19 @@ pub fn mesher(data: &[u8]) -> Result<(), Violation> {
 
 /// Checks everything a meshing run promises:
 ///
-/// - invalid parameters give exactly the error [`MeshParams::validate`] gives; valid ones give a
-///   mesh or one of the errors that depend on the field ([`MeshError::SingularInitialPoint`],
-///   [`MeshError::DirectionParallelToNormal`], [`MeshError::Triangulation`]);
+/// - parameters that do not resolve on `field` give exactly the error
+///   [`MeshParams::resolve`] gives; ones that resolve give a mesh, with those resolved
+///   parameters, or one of the errors that depend on the field's course
+///   ([`MeshError::SingularInitialPoint`], [`MeshError::DirectionParallelToNormal`],
+///   [`MeshError::Triangulation`], [`MeshError::Empty`]), never [`MeshError::Invalid`];
 /// - the samples satisfy [`check_samples`] (budgets, step band, bookkeeping);
 /// - the chart triangulation satisfies [`check_chart`];
+/// - the run's validation passes, and so does a validation of the mesh it returned (an
+///   embedded, consistently oriented 2-manifold, possibly with boundary, decided exactly);
 /// - the mesh satisfies [`check_mesh`] (no NaN, no degenerate or duplicate triangles, manifold,
 ///   consistently oriented), has at most as many triangles as the chart and closing
-///   triangulations (triangles of no area in space are left out), and its vertices are the
-///   run's working-precision vertices rounded to `f64`;
+///   triangulations and the stitching added (triangles of no area in space are left out), and
+///   its vertices are the run's working-precision vertices rounded to `f64`;
 /// - refinement ([`MeshParams::max_normal_error`]) counts the vertices it added and the faces
 ///   of `field` it left over the bound correctly, and adds at most two faces per vertex.
 pub fn check_run(
@@ -395,11 +409,12 @@ pub fn check_run(
     params: &MeshParams,
     result: &Result<MeshRun<f64>, MeshError>,
 ) -> Result<(), Violation> {
-    let run = match (params.validate(), result) {
+    let resolved = params.resolve::<f64, _>(field);
+    let run = match (resolved.as_ref(), result) {
         (Err(expected), Err(got)) => {
             // Compared as text: the errors carry the offending value, which may be NaN.
             ensure!(
-                std::mem::discriminant(&expected) == std::mem::discriminant(got)
+                std::mem::discriminant(expected) == std::mem::discriminant(got)
                     && expected.to_string() == got.to_string(),
                 "invalid parameters should give `{expected}`, got `{got}`"
             );
@@ -410,24 +425,58 @@ pub fn check_run(
                 "invalid parameters ({expected}) gave a mesh"
             )))
         }
-        (Ok(()), Err(e)) => {
+        (Ok(_), Err(e)) => {
+            ensure!(
+                !matches!(e, MeshError::Invalid(_)),
+                "the mesh failed validation: `{e}`"
+            );
             ensure!(
                 matches!(
                     e,
                     MeshError::SingularInitialPoint { .. }
                         | MeshError::DirectionParallelToNormal { .. }
                         | MeshError::Triangulation(_)
+                        | MeshError::Empty { .. }
                 ),
                 "valid parameters gave the parameter error `{e}`"
             );
             ensure!(!e.to_string().is_empty(), "empty error message");
             return Ok(());
         }
-        (Ok(()), Ok(run)) => run,
+        (Ok(resolved), Ok(run)) => {
+            // Compared as text: NaN-safe.
+            ensure!(
+                format!("{:?}", run.params) == format!("{resolved:?}"),
+                "the run reports the parameters {:?}, resolving them gives {resolved:?}",
+                run.params
+            );
+            run
+        }
     };
+    let params = &run.params;
     check_samples(params, &run.samples)?;
     let n = run.samples.points.len();
     check_chart(&run.chart, n)?;
+    ensure!(
+        run.validation.is_valid(),
+        "the run's validation fails: {}",
+        run.validation
+    );
+    let validation = run.mesh.validate();
+    ensure!(
+        validation.is_valid(),
+        "the mesh returned fails validation: {validation}"
+    );
+    ensure!(
+        validation.faces == run.mesh.triangles.len()
+            && validation.faces == run.validation.faces
+            && validation.euler_characteristic == run.validation.euler_characteristic,
+        "the run's validation ({} faces, χ = {}) does not describe the {} faces returned \
+         (validated again: {validation})",
+        run.validation.faces,
+        run.validation.euler_characteristic,
+        run.mesh.triangles.len()
+    );
     check_mesh(&run.mesh)?;
     ensure!(
         run.vertices.len() == run.mesh.vertices.len()
@@ -440,35 +489,41 @@ pub fn check_run(
         run.vertices.len(),
         run.mesh.vertices.len()
     );
-    // Each vertex that refinement added split one or two faces in two.
+    // Each vertex that refinement added split one or two faces in two; faces removed later
+    // (crossings undone, pinches cut) may take some of them with them.
     let refined = (run.mesh.provenance.iter())
         .filter(|p| p.curve == Provenance::REFINED_CURVE)
         .count();
     ensure!(
-        run.refinement.map_or(0, |r| r.added) == refined,
+        refined <= run.refinement.map_or(0, |r| r.added),
         "refinement says it added {:?} vertices, the mesh has {refined}",
         run.refinement
     );
     ensure!(
         run.mesh.triangles.len()
-            <= run.chart.triangles.len() + run.chart.closing.len() + 2 * refined,
-        "the mesh has {} triangles, more than the charts' {} + {} and two per refined vertex ({refined})",
+            <= run.chart.triangles.len()
+                + run.chart.closing.len()
+                + run.stitched.added
+                + 2 * refined,
+        "the mesh has {} triangles, more than the charts' {} + {}, the {} stitched and two per \
+         refined vertex ({refined})",
         run.mesh.triangles.len(),
         run.chart.triangles.len(),
-        run.chart.closing.len()
+        run.chart.closing.len(),
+        run.stitched.added
     );
     if let (Some(limit), Some(r)) = (params.max_normal_error, run.refinement) {
         let over = (run.mesh.triangles.iter())
             .filter(|t| {
                 let corners = t.map(|i| run.mesh.vertices[i as usize]);
-                liemesh::quality::face_error_deg(corners, |c| field.normal(c)) > limit.to_degrees()
+                liemesh::quality::face_error_deg(corners, |c| field.normal(c)) > limit.degrees()
             })
             .count();
         ensure!(
             over == r.over_limit,
             "refinement says {} faces are over {}°, the mesh has {over}",
             r.over_limit,
-            limit.to_degrees()
+            limit.degrees()
         );
     }
     Ok(())
@@ -477,13 +532,13 @@ pub fn check_run(
 /// Checks the sampler's output against `params`:
 ///
 /// - points, normals, provenance and step records have one entry per point, all finite;
-/// - budgets: at most `max_points` points and `max_curves` curves, at most
-///   `max_steps_per_curve + 1` points per curve;
+/// - budgets: at most `max_points` points and `max_curves` curves, at most `max_steps + 1`
+///   points per curve;
 /// - every point but `p0` is on exactly one curve, where its provenance says (curve, step),
 ///   with the curve's θ; arc lengths add up the step lengths and stay within `max_radius`;
 /// - every accepted step (`dt > 0`, exactly the points with `step > 0`) lies in the bounding
 ///   box and has its predicted α inside `[β_min, β_max]` unless its limit says otherwise.
-pub fn check_samples(params: &MeshParams, s: &Samples<f64>) -> Result<(), Violation> {
+pub fn check_samples(params: &Resolved, s: &Samples<f64>) -> Result<(), Violation> {
     let n = s.points.len();
     ensure!(n >= 1, "no sample points");
     ensure!(
@@ -493,7 +548,7 @@ pub fn check_samples(params: &MeshParams, s: &Samples<f64>) -> Result<(), Violat
         s.provenance.len(),
         s.steps.len()
     );
-    let b = &params.budget;
+    let b = &**params;
     ensure!(
         n <= b.max_points,
         "{n} points exceed the budget max_points = {}",
@@ -516,10 +571,10 @@ pub fn check_samples(params: &MeshParams, s: &Samples<f64>) -> Result<(), Violat
     let mut seen = vec![0u32; n];
     for (c, curve) in s.curves.iter().enumerate() {
         ensure!(
-            curve.points.len() <= b.max_steps_per_curve + 1,
-            "curve {c} has {} points, more than max_steps_per_curve + 1 = {}",
+            curve.points.len() <= b.max_steps + 1,
+            "curve {c} has {} points, more than max_steps + 1 = {}",
             curve.points.len(),
-            b.max_steps_per_curve + 1
+            b.max_steps + 1
         );
         ensure!(!curve.points.is_empty(), "curve {c} has no points");
         let mut prev_s = None;
@@ -562,23 +617,23 @@ pub fn check_samples(params: &MeshParams, s: &Samples<f64>) -> Result<(), Violat
 }
 
 fn check_step(
-    params: &MeshParams,
+    params: &Resolved,
     i: usize,
     st: &StepRecord,
     p: [f64; 3],
     pr: &Provenance,
 ) -> Result<(), Violation> {
     ensure!(
-        pr.s.is_finite() && pr.theta.is_finite() && pr.s <= params.terminal.max_radius,
+        pr.s.is_finite() && pr.theta.is_finite() && pr.s <= params.max_radius,
         "point {i} (step {} of curve {}): arc length {} beyond max_radius {} (or not finite, \
          θ = {})",
         pr.step,
         pr.curve,
         pr.s,
-        params.terminal.max_radius,
+        params.max_radius,
         pr.theta
     );
-    let bb = params.terminal.bounding_box;
+    let bb = params.bounding_box;
     ensure!(
         i == 0 || p.iter().all(|x| x.abs() <= bb),
         "point {i} = {p:?} (step {} of curve {}) lies outside the bounding box ±{bb}",
@@ -588,13 +643,14 @@ fn check_step(
     if st.dt <= 0.0 {
         return Ok(());
     }
+    let (beta_min, beta_max) = (params.beta_min.radians(), params.beta_max.radians());
     ensure!(
         st.limit != StepLimit::None
-            || (st.alpha_predicted >= params.beta_min && st.alpha_predicted <= params.beta_max),
+            || (st.alpha_predicted >= beta_min && st.alpha_predicted <= beta_max),
         "point {i}: accepted step with α = {}° outside [{}°, {}°] and no limit reported ({st:?})",
         st.alpha_predicted.to_degrees(),
-        params.beta_min.to_degrees(),
-        params.beta_max.to_degrees()
+        params.beta_min.degrees(),
+        params.beta_max.degrees()
     );
     Ok(())
 }
@@ -915,7 +971,7 @@ impl TriangulateInput {
             SamplesInput::Preset { preset, points } => {
                 let p = Preset::ALL[*preset as usize % Preset::ALL.len()];
                 let mut params = p.params();
-                params.budget.max_points = 16 + 2 * *points as usize;
+                params.max_points = 16 + 2 * *points as usize;
                 let field = LieField::<f64>::new(&p.invariant());
                 liemesh::sample::sample(&field, &params).expect("presets sample")
             }
@@ -1160,8 +1216,8 @@ pub fn invariant_file(data: &[u8]) -> Result<(), Violation> {
 }
 
 /// Checks a parsed invariant file: a valid one has 6 or 18 finite numbers that rebuild the
-/// same invariant and a patch that applies to the default parameters; an error message is one
-/// non-empty line naming the file.
+/// same invariant, and parameters that resolve on the invariant's field or give an error with
+/// a message; an error message is one non-empty line naming the file.
 #[cfg(feature = "toml")]
 pub fn check_invariant_file(
     result: &Result<InvariantFile, InvariantFileError>,
@@ -1181,10 +1237,13 @@ pub fn check_invariant_file(
                 "{numbers:?} rebuild {again:?}, not {:?}",
                 f.invariant
             );
-            let mut params = MeshParams::default();
-            f.patch.apply(&mut params).map_err(|(key, msg)| {
-                Violation(format!("an accepted patch does not apply: {key}: {msg}"))
-            })?;
+            let field = LieField::<f64>::new(&f.invariant);
+            if let Err(e) = f.params.resolve::<f64, _>(&field) {
+                ensure!(
+                    !e.to_string().is_empty(),
+                    "empty error message resolving the file's parameters"
+                );
+            }
         }
         Err(e) => {
             let msg = e.to_string();
@@ -1282,7 +1341,7 @@ mod tests {
         let input = MesherInput::arbitrary_take_rest(Unstructured::new(&[])).unwrap();
         assert_eq!(input.base(), Preset::Fig1);
         let mut expected = Preset::Fig1.params();
-        expected.budget = BudgetInput::Small.budget();
+        BudgetInput::Small.apply(&mut expected);
         assert_eq!(input.params(), expected);
         assert_eq!(input.numbers(), Preset::Fig1.invariant().numbers());
     }

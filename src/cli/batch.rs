@@ -12,7 +12,6 @@ use liemesh::io::invariant_file::InvariantFile;
 use liemesh::io::report::Report;
 use liemesh::io::{self, MeshFormat, WriteOptions};
 use liemesh::scalar::ScalarKind;
-use liemesh::MeshParams;
 use rayon::prelude::*;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -96,10 +95,7 @@ pub fn collect_inputs(inputs: &[PathBuf]) -> Result<Vec<PathBuf>, CliError> {
 fn mesh_one(input: &Path, out: &Path, format: MeshFormat) -> Result<BatchDone, CliError> {
     let t0 = Instant::now();
     let file = InvariantFile::read(input)?;
-    let mut params = MeshParams::default();
-    file.patch
-        .apply(&mut params)
-        .map_err(|(k, m)| CliError::Usage(format!("{}: mesh.{k}: {m}", input.display())))?;
+    let params = file.params;
     let outcome = mesh_invariant(&file.invariant, &params, ScalarKind::F64, true)?;
     let stem = input.file_stem().unwrap_or_default().to_string_lossy();
     let mesh_path = out.join(format!("{stem}.{}", format.extension()));
@@ -119,8 +115,7 @@ fn mesh_one(input: &Path, out: &Path, format: MeshFormat) -> Result<BatchDone, C
         0.0,
         &params,
     );
-    report.quality = outcome.quality;
-    report.refinement = outcome.refinement;
+    outcome.fill(&mut report);
     write_json(&report_path, &report)?;
     Ok(BatchDone {
         mesh: mesh_path,

@@ -330,7 +330,7 @@ fn fidelity(
     }
     Ok(FidelityRow {
         workload: if ellipsoid { "ellipsoid" } else { "sphere" }.to_string(),
-        beta_deg: [params.beta_min.to_degrees(), params.beta_max.to_degrees()],
+        beta_deg: [params.beta_min.degrees(), params.beta_max.degrees()],
         gap: [params.gap, params.merge],
         triangles: found.triangles,
         refined: found.refined,

@@ -2,7 +2,7 @@
 
 use super::CliError;
 use clap::Args;
-use liemesh::io::invariant_file::{InvariantFile, ParamsPatch};
+use liemesh::io::invariant_file::InvariantFile;
 use liemesh::io::report::Report;
 use liemesh::io::{self, WriteOptions};
 use liemesh::model::{Invariant, LieField};
@@ -75,108 +75,125 @@ impl From<ScalarArg> for ScalarKind {
     }
 }
 
-/// Every mesher parameter as a flag.
-#[derive(Debug, Clone, Default, Args)]
+/// Every mesher parameter as a flag. Each flag is applied onto [`MeshParams`] through serde
+/// under its key in the invariant file's `[mesh]` table (no field-by-field copy: a test
+/// checks that every flag names a parameter).
+#[derive(Debug, Clone, Default, Args, serde::Serialize)]
 pub struct Overrides {
     /// Curve layout: `proposed` or `previous`.
     #[arg(long, value_parser = ["proposed", "previous"])]
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub method: Option<String>,
     /// Number of curves of the previous method (implies --method previous).
     #[arg(long)]
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub curves: Option<usize>,
     /// Step rule: `default` (drift-free) or `paper` (explicit Euler, retry loop).
     #[arg(long, value_parser = ["default", "paper"])]
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub mode: Option<String>,
     /// Initial point `x,y,z`.
     #[arg(long, value_parser = parse_vec3, allow_hyphen_values = true)]
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub p0: Option<[f64; 3]>,
-    /// Initial direction `x,y,z`.
+    /// Initial direction `x,y,z` (default: the axis least aligned with the normal at p0).
     #[arg(long, value_parser = parse_vec3, allow_hyphen_values = true)]
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub w00: Option<[f64; 3]>,
-    /// Initial step Δt.
+    /// Initial step Δt (default: from the surface's curvature at p0).
     #[arg(long, allow_hyphen_values = true)]
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub dt: Option<f64>,
     /// Smallest step.
     #[arg(long, allow_hyphen_values = true)]
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub dt_min: Option<f64>,
     /// Largest step.
     #[arg(long, allow_hyphen_values = true)]
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub dt_max: Option<f64>,
     /// β_min in degrees.
-    #[arg(long, allow_hyphen_values = true)]
+    #[arg(long, allow_hyphen_values = true, value_name = "DEG")]
+    #[serde(rename = "beta_min_deg", skip_serializing_if = "Option::is_none")]
     pub beta_min: Option<f64>,
     /// β_max in degrees.
-    #[arg(long, allow_hyphen_values = true)]
+    #[arg(long, allow_hyphen_values = true, value_name = "DEG")]
+    #[serde(rename = "beta_max_deg", skip_serializing_if = "Option::is_none")]
     pub beta_max: Option<f64>,
     /// Growth factor δ > 1.
     #[arg(long, allow_hyphen_values = true)]
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub grow: Option<f64>,
     /// Shrink factor δ' in (0, 1).
     #[arg(long, allow_hyphen_values = true)]
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub shrink: Option<f64>,
     /// Insert a curve when neighbours are this many steps apart.
     #[arg(long, allow_hyphen_values = true)]
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub gap: Option<f64>,
     /// End a curve closer than this many steps to a neighbour.
     #[arg(long, allow_hyphen_values = true)]
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub merge: Option<f64>,
-    /// Largest geodesic radius.
+    /// Largest geodesic radius (default: from the surface's size at p0).
     #[arg(long, allow_hyphen_values = true)]
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub max_radius: Option<f64>,
-    /// Half-size of the bounding box around the origin.
+    /// Half-size of the bounding box around the origin (default: from the surface's size).
     #[arg(long, allow_hyphen_values = true)]
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub bounding_box: Option<f64>,
-    /// Do not end curves on collisions nor close the surface.
+    /// Do not stop curves where fronts meet nor stitch them (`close = false`).
     #[arg(long)]
+    #[serde(skip)]
     pub no_close: bool,
     /// Point budget.
     #[arg(long)]
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub max_points: Option<usize>,
     /// Curve budget.
     #[arg(long)]
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub max_curves: Option<usize>,
     /// Steps-per-curve budget.
     #[arg(long)]
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub max_steps: Option<usize>,
     /// Retries-per-step budget (paper mode), or Newton iterations per chord (default mode,
     /// 4 to 64).
     #[arg(long)]
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub max_retries: Option<usize>,
     /// Refine the mesh until no face's normal deviates from the field normal at its
     /// centroid by more than this many degrees (splits the longest edges of the worst faces)
     #[arg(long, allow_hyphen_values = true, value_name = "DEG")]
+    #[serde(
+        rename = "max_normal_error_deg",
+        skip_serializing_if = "Option::is_none"
+    )]
     pub max_normal_error: Option<f64>,
 }
 
 impl Overrides {
-    fn patch(&self) -> ParamsPatch {
-        ParamsPatch {
-            method: self
-                .method
-                .clone()
-                .or(self.curves.map(|_| "previous".into())),
-            curves: self.curves,
-            mode: self.mode.clone(),
-            p0: self.p0,
-            w00: self.w00,
-            dt: self.dt,
-            dt_min: self.dt_min,
-            dt_max: self.dt_max,
-            beta_min_deg: self.beta_min,
-            beta_max_deg: self.beta_max,
-            grow: self.grow,
-            shrink: self.shrink,
-            gap: self.gap,
-            merge: self.merge,
-            max_radius: self.max_radius,
-            bounding_box: self.bounding_box,
-            close: self.no_close.then_some(false),
-            max_points: self.max_points,
-            max_curves: self.max_curves,
-            max_steps: self.max_steps,
-            max_retries: self.max_retries,
-            max_normal_error_deg: self.max_normal_error,
+    /// `params` with the flags given applied on top.
+    pub fn apply(&self, params: MeshParams) -> Result<MeshParams, CliError> {
+        let bad = |e: serde_json::Error| CliError::Usage(format!("parameters: {e}"));
+        let mut value = serde_json::to_value(&params).map_err(bad)?;
+        let flags = serde_json::to_value(self).map_err(bad)?;
+        let (Some(target), Some(given)) = (value.as_object_mut(), flags.as_object()) else {
+            return Err(CliError::Usage("parameters are not a table".into()));
+        };
+        for (key, v) in given {
+            target.insert(key.clone(), v.clone());
         }
+        if self.curves.is_some() && self.method.is_none() {
+            target.insert("method".into(), "previous".into());
+        }
+        if self.no_close {
+            target.insert("close".into(), false.into());
+        }
+        serde_json::from_value(value).map_err(bad)
     }
 }
 
@@ -225,11 +242,7 @@ impl MeshArgs {
             (Some(p), None) => (Some(*p), p.invariant(), p.params()),
             (None, Some(path)) => {
                 let file = InvariantFile::read(path)?;
-                let mut params = MeshParams::default();
-                file.patch.apply(&mut params).map_err(|(k, m)| {
-                    CliError::Usage(format!("{}: mesh.{k}: {m}", path.display()))
-                })?;
-                (None, file.invariant, params)
+                (None, file.invariant, file.params)
             }
             (None, None) => (
                 Some(Preset::Fig6),
@@ -242,10 +255,7 @@ impl MeshArgs {
                 ))
             }
         };
-        self.overrides
-            .patch()
-            .apply(&mut params)
-            .map_err(|(k, m)| CliError::Usage(format!("--{k}: {m}")))?;
+        params = self.overrides.apply(params)?;
         Ok((preset, invariant, params))
     }
 }
@@ -263,6 +273,32 @@ pub struct MeshOutcome {
     pub quality: Option<liemesh::quality::QualityReport>,
     /// What refinement to a normal-error bound did, when asked for.
     pub refinement: Option<liemesh::triangulate::Refinement>,
+    /// The parameters with their automatic values.
+    pub resolved: liemesh::Resolved,
+    /// How many curves ended for each reason.
+    pub curve_ends: liemesh::sample::CurveEnds,
+    /// The budgets that cut the run short, in words.
+    pub cut_short: Vec<String>,
+    /// What stitching did.
+    pub stitched: liemesh::triangulate::Stitched,
+    /// What untangling did.
+    pub untangled: liemesh::triangulate::Untangled,
+    /// The mesh's validation.
+    pub validation: liemesh::mesh::Validation,
+}
+
+impl MeshOutcome {
+    /// Carries what the run found into `report`.
+    pub fn fill(&self, report: &mut Report) {
+        report.quality = self.quality.clone();
+        report.refinement = self.refinement;
+        report.resolved = Some(self.resolved.clone());
+        report.curve_ends = self.curve_ends;
+        report.cut_short = self.cut_short.clone();
+        report.stitched = self.stitched;
+        report.untangled = self.untangled;
+        report.validation = Some(self.validation.clone());
+    }
 }
 
 fn mesh_in<T: Scalar>(
@@ -277,12 +313,19 @@ fn mesh_in<T: Scalar>(
     let quality = measure.then(|| {
         liemesh::quality::QualityReport::measure(invariant, params, &run.samples, &run.mesh)
     });
+    let cut_short = run.cut_short();
     Ok(MeshOutcome {
         curves: run.samples.curves.len(),
+        curve_ends: run.samples.ends(),
         mesh: run.mesh,
         seconds,
         quality,
         refinement: run.refinement,
+        resolved: run.params,
+        cut_short,
+        stitched: run.stitched,
+        untangled: run.untangled,
+        validation: run.validation,
     })
 }
 
@@ -350,8 +393,7 @@ pub(super) fn run(args: &MeshArgs) -> Result<ExitCode, CliError> {
         outcome.seconds,
         &params,
     );
-    report.quality = outcome.quality.clone();
-    report.refinement = outcome.refinement;
+    outcome.fill(&mut report);
     if let Some(path) = &args.report {
         write_json(path, &report)?;
     }
@@ -420,9 +462,27 @@ fn print_summary(r: &Report, mesh: Option<&Path>, report: Option<&Path>) {
         r.boundary_loops,
         if r.boundary_loops == 1 { "" } else { "s" }
     );
+    let e = &r.curve_ends;
+    println!(
+        "  curve ends {} met other fronts, {} merged, {} at the radius, {} at the box, {} \
+         singular, {} on a budget",
+        e.collision, e.merge, e.radius, e.bounding_box, e.singular, e.budget
+    );
+    if let Some(v) = &r.validation {
+        println!("  validation {v}");
+    }
+    if r.untangled.removed + r.untangled.reverted > 0 {
+        println!(
+            "  untangled  {} relaxation moves taken back, {} crossing faces removed",
+            r.untangled.reverted, r.untangled.removed
+        );
+    }
+    if !r.cut_short.is_empty() {
+        println!("  INCOMPLETE {}", r.cut_short.join("; "));
+    }
     println!("  time       {:.2} ms", r.seconds * 1e3);
     if let (Some(f), Some(limit)) = (&r.refinement, r.parameters.max_normal_error) {
-        let limit = limit.to_degrees();
+        let limit = limit.degrees();
         println!(
             "  refinement {} vertices in {} round{}; {}",
             f.added,

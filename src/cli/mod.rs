@@ -126,7 +126,11 @@ pub fn main() -> ExitCode {
         Ok(code) => code,
         Err(e) => {
             eprintln!("liemesh: error: {}", for_the_command_line(&e));
-            ExitCode::from(2)
+            // A mesh that failed its own validation is a failed check (1), not bad input (2).
+            match e {
+                CliError::Mesh(liemesh::MeshError::Invalid(_)) => ExitCode::from(1),
+                _ => ExitCode::from(2),
+            }
         }
     }
 }

@@ -41,10 +41,8 @@ pub struct QualityRow {
 /// Meshes `preset` in `mode` and measures it.
 pub fn quality_row(preset: Preset, mode: Mode) -> Result<QualityRow, CliError> {
     let invariant = preset.invariant();
-    let params = liemesh::MeshParams {
-        mode,
-        ..preset.params()
-    };
+    let mut params = preset.params();
+    params.mode = mode;
     let start = Instant::now();
     let run = liemesh::run(&LieField::<f64>::new(&invariant), &params)?;
     let milliseconds = start.elapsed().as_secs_f64() * 1e3;

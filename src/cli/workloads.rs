@@ -4,7 +4,7 @@
 
 use liemesh::model::{Invariant, LieField};
 use liemesh::preset::Preset;
-use liemesh::{MeshError, MeshParams};
+use liemesh::{Angle, MeshError, MeshParams};
 
 /// The face-normal error the fidelity workload must reach (degrees): what grid-based implicit
 /// meshers show at about 10^5 sphere triangles.
@@ -33,9 +33,9 @@ pub fn workload_params(ellipsoid: bool, target: usize) -> (Invariant, MeshParams
     // The ellipsoid gets about 4.6 times the sphere's count at the same β band.
     let base = if ellipsoid { 9000.0 } else { 2000.0 };
     let s = (target as f64 / base).sqrt();
-    params.beta_min /= s;
-    params.beta_max /= s;
-    params.dt /= s;
+    params.beta_min = params.beta_min / s;
+    params.beta_max = params.beta_max / s;
+    params.dt = params.dt.map(|dt| dt / s);
     params.p0 = if ellipsoid {
         [0.0, 0.0, 0.25]
     } else {
@@ -74,10 +74,10 @@ pub fn fidelity_scan(ellipsoid: bool, max_triangles: usize) -> Result<FidelitySc
         let mut params = base.clone();
         params.gap = gap;
         params.merge = merge;
-        params.beta_min *= scale;
-        params.beta_max *= scale;
-        params.dt *= scale;
-        params.max_normal_error = Some(FIDELITY_LIMIT_DEG.to_radians());
+        params.beta_min = params.beta_min * scale;
+        params.beta_max = params.beta_max * scale;
+        params.dt = params.dt.map(|dt| dt * scale);
+        params.max_normal_error = Some(Angle::from_degrees(FIDELITY_LIMIT_DEG));
         params
     };
     // The coarsest within the limit, else the lowest error.

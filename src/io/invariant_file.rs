@@ -7,17 +7,18 @@
 //! [mesh]            # every key is optional; missing ones keep their defaults
 //! method = "proposed"   # or "previous" (then `curves` sets their number)
 //! mode = "default"      # or "paper"
-//! p0 = [0.0, 0.0, 1.0]
-//! dt = 0.05
+//! p0 = [0.0, 0.0, 0.25]
+//! dt = 0.05             # lengths left out follow the surface's size at p0
 //! beta_min_deg = 4.0
 //! beta_max_deg = 8.0
 //! ```
 //!
-//! Unknown keys and values of the wrong type are errors that name the key.
+//! The `[mesh]` keys are [`MeshParams`]'s fields, angles in degrees (`*_deg`). Unknown keys
+//! and values of the wrong type are errors that name the key.
 
 use crate::model::{Invariant, InvariantError};
-use crate::params::{MeshParams, Method, Mode};
-use serde::{Deserialize, Serialize};
+use crate::params::MeshParams;
+use serde::Deserialize;
 use std::path::{Path, PathBuf};
 use thiserror::Error;
 
@@ -48,136 +49,6 @@ pub enum InvariantFileError {
         /// The cause.
         source: InvariantError,
     },
-    /// A parameter combination is invalid.
-    #[error("invariant file '{path}': key `mesh.{key}`: {message}")]
-    Parameter {
-        /// The file.
-        path: PathBuf,
-        /// The key.
-        key: &'static str,
-        /// What is allowed.
-        message: String,
-    },
-}
-
-/// Overrides of [`MeshParams`], as written in a file or on the command line
-/// (angles in degrees).
-#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct ParamsPatch {
-    /// `"proposed"` or `"previous"`.
-    pub method: Option<String>,
-    /// Number of curves of the previous method.
-    pub curves: Option<usize>,
-    /// `"default"` or `"paper"`.
-    pub mode: Option<String>,
-    /// Initial point.
-    pub p0: Option<[f64; 3]>,
-    /// Initial direction.
-    pub w00: Option<[f64; 3]>,
-    /// Initial step Δt.
-    pub dt: Option<f64>,
-    /// Smallest step.
-    pub dt_min: Option<f64>,
-    /// Largest step.
-    pub dt_max: Option<f64>,
-    /// β_min in degrees.
-    pub beta_min_deg: Option<f64>,
-    /// β_max in degrees.
-    pub beta_max_deg: Option<f64>,
-    /// δ.
-    pub grow: Option<f64>,
-    /// δ'.
-    pub shrink: Option<f64>,
-    /// Insertion threshold in steps.
-    pub gap: Option<f64>,
-    /// Merge threshold in steps.
-    pub merge: Option<f64>,
-    /// Largest geodesic radius.
-    pub max_radius: Option<f64>,
-    /// Bounding box half-size.
-    pub bounding_box: Option<f64>,
-    /// Close closed surfaces.
-    pub close: Option<bool>,
-    /// Point budget.
-    pub max_points: Option<usize>,
-    /// Curve budget.
-    pub max_curves: Option<usize>,
-    /// Steps per curve budget.
-    pub max_steps: Option<usize>,
-    /// Retry budget per step.
-    pub max_retries: Option<usize>,
-    /// Refine faces whose normal error exceeds this many degrees.
-    pub max_normal_error_deg: Option<f64>,
-}
-
-impl ParamsPatch {
-    /// Applies the overrides to `params`; `Err((key, allowed))` for a bad enumeration value.
-    pub fn apply(&self, params: &mut MeshParams) -> Result<(), (&'static str, String)> {
-        if let Some(m) = &self.method {
-            params.method = match m.as_str() {
-                "proposed" => Method::Proposed,
-                "previous" => Method::Previous {
-                    curves: self.curves.unwrap_or(15),
-                },
-                other => {
-                    return Err((
-                        "method",
-                        format!(
-                            "got \"{other}\"; allowed values are \"proposed\" and \"previous\""
-                        ),
-                    ))
-                }
-            };
-        } else if let (Some(n), Method::Previous { .. }) = (self.curves, params.method) {
-            params.method = Method::Previous { curves: n };
-        }
-        if let Some(m) = &self.mode {
-            params.mode = match m.as_str() {
-                "default" => Mode::Default,
-                "paper" => Mode::Paper,
-                other => {
-                    return Err((
-                        "mode",
-                        format!("got \"{other}\"; allowed values are \"default\" and \"paper\""),
-                    ))
-                }
-            };
-        }
-        macro_rules! set {
-            ($($field:ident => $target:expr),* $(,)?) => {
-                $(if let Some(v) = self.$field { $target = v; })*
-            };
-        }
-        set!(
-            p0 => params.p0,
-            w00 => params.w00,
-            dt => params.dt,
-            dt_min => params.dt_min,
-            dt_max => params.dt_max,
-            grow => params.grow,
-            shrink => params.shrink,
-            gap => params.gap,
-            merge => params.merge,
-            max_radius => params.terminal.max_radius,
-            bounding_box => params.terminal.bounding_box,
-            close => params.terminal.close,
-            max_points => params.budget.max_points,
-            max_curves => params.budget.max_curves,
-            max_steps => params.budget.max_steps_per_curve,
-            max_retries => params.budget.max_retries,
-        );
-        if let Some(d) = self.beta_min_deg {
-            params.beta_min = d.to_radians();
-        }
-        if let Some(d) = self.beta_max_deg {
-            params.beta_max = d.to_radians();
-        }
-        if let Some(d) = self.max_normal_error_deg {
-            params.max_normal_error = Some(d.to_radians());
-        }
-        Ok(())
-    }
 }
 
 #[derive(Deserialize)]
@@ -185,17 +56,17 @@ impl ParamsPatch {
 struct FileContents {
     invariant: Vec<f64>,
     #[serde(default)]
-    mesh: ParamsPatch,
+    mesh: MeshParams,
 }
 
-/// An invariant file's contents: the invariant and the parameters (defaults overridden by
-/// the file's `[mesh]` table).
+/// An invariant file's contents: the invariant and the parameters (the defaults, overridden
+/// by the file's `[mesh]` table).
 #[derive(Clone, Debug, PartialEq)]
 pub struct InvariantFile {
     /// The invariant.
     pub invariant: Invariant,
-    /// The overrides the file gave.
-    pub patch: ParamsPatch,
+    /// The parameters.
+    pub params: MeshParams,
 }
 
 impl InvariantFile {
@@ -221,17 +92,9 @@ impl InvariantFile {
                 source,
             }
         })?;
-        let mut probe = MeshParams::default();
-        contents.mesh.apply(&mut probe).map_err(|(key, message)| {
-            InvariantFileError::Parameter {
-                path: path.to_path_buf(),
-                key,
-                message,
-            }
-        })?;
         Ok(InvariantFile {
             invariant,
-            patch: contents.mesh,
+            params: contents.mesh,
         })
     }
 }
@@ -258,7 +121,7 @@ mod tests {
     fn a_minimal_file_has_only_the_invariant() {
         let f = parse("invariant = [1, 4, 16, 0, 0, 0]").unwrap();
         assert_eq!(f.invariant.numbers(), vec![1.0, 4.0, 16.0, 0.0, 0.0, 0.0]);
-        assert_eq!(f.patch, ParamsPatch::default());
+        assert_eq!(f.params, MeshParams::default());
     }
 
     #[test]
@@ -273,10 +136,7 @@ mod tests {
     fn a_bad_method_names_the_allowed_values() {
         let e = parse("invariant = [1, 1, 1, 0, 0, 0]\n[mesh]\nmethod = \"fast\"").unwrap_err();
         let msg = e.to_string();
-        assert!(
-            msg.contains("mesh.method") && msg.contains("\"proposed\""),
-            "{msg}"
-        );
+        assert!(msg.contains("fast") && msg.contains("`proposed`"), "{msg}");
     }
 
     #[test]

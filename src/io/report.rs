@@ -35,8 +35,33 @@ pub struct Report {
     pub topology: Topology,
     /// Wall-clock seconds for sampling and triangulation.
     pub seconds: f64,
-    /// The parameters used.
+    /// The parameters given.
     pub parameters: MeshParams,
+    /// The automatic parameters as worked out for this surface (`scales`, `w00`, `dt`,
+    /// `dt_min`, `dt_max`, `max_radius`, `bounding_box`).
+    #[cfg_attr(
+        feature = "serde",
+        serde(default, skip_serializing_if = "Option::is_none")
+    )]
+    pub resolved: Option<crate::params::Resolved>,
+    /// How many curves ended for each reason.
+    #[cfg_attr(feature = "serde", serde(default))]
+    pub curve_ends: crate::sample::CurveEnds,
+    /// The budgets that cut the run short, in words; empty for a complete run.
+    #[cfg_attr(feature = "serde", serde(default))]
+    pub cut_short: Vec<String>,
+    /// What stitching where fronts met did.
+    #[cfg_attr(feature = "serde", serde(default))]
+    pub stitched: crate::triangulate::Stitched,
+    /// What was undone so that the mesh does not cross itself.
+    #[cfg_attr(feature = "serde", serde(default))]
+    pub untangled: crate::triangulate::Untangled,
+    /// The exact validation of the mesh written.
+    #[cfg_attr(
+        feature = "serde",
+        serde(default, skip_serializing_if = "Option::is_none")
+    )]
+    pub validation: Option<crate::mesh::Validation>,
     /// Quality measures (shape, fidelity, topology, recovered invariant), when measured.
     pub quality: Option<crate::quality::QualityReport>,
     /// What refinement to [`MeshParams::max_normal_error`] did, when it was asked for.
@@ -73,6 +98,12 @@ impl Report {
             topology,
             seconds,
             parameters: parameters.clone(),
+            resolved: None,
+            curve_ends: Default::default(),
+            cut_short: Vec::new(),
+            stitched: Default::default(),
+            untangled: Default::default(),
+            validation: None,
             quality: None,
             refinement: None,
         }

@@ -12,4 +12,4 @@ mod shape;
 
 pub use field::{jacobian, FnField, LieField, NormalField};
 pub use invariant::{Invariant, InvariantError, InvariantKind, Lift, Mat3};
-pub use shape::{least_aligned_tangent, LocalShape};
+pub use shape::{least_aligned_tangent, LocalShape, INTEGRABLE_DEFECT};

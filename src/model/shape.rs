@@ -7,6 +7,11 @@
 use super::NormalField;
 use crate::scalar::{Scalar, Vec3};
 
+/// A field whose [integrability defect](LocalShape::integrability_defect) stays below this is
+/// treated as integrable (rounding leaves about 1e-16 on the model's integrable fields; a
+/// rotation of 0.001 rad leaves 1e-3).
+pub const INTEGRABLE_DEFECT: f64 = 1e-9;
+
 /// The local shape of the surface through a point.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct LocalShape {
@@ -48,7 +53,11 @@ impl LocalShape {
         if !(k1.is_finite() && k2.is_finite()) {
             return None;
         }
-        let curvatures = if k1.abs() >= k2.abs() { [k1, k2] } else { [k2, k1] };
+        let curvatures = if k1.abs() >= k2.abs() {
+            [k1, k2]
+        } else {
+            [k2, k1]
+        };
         let j = super::jacobian(field, &q).map(|row| row.to_f64());
         let curl = [j[2][1] - j[1][2], j[0][2] - j[2][0], j[1][0] - j[0][1]];
         let size = j.iter().map(|r| dot(*r, *r)).sum::<f64>().sqrt();
@@ -136,7 +145,11 @@ mod tests {
     fn a_saddle_has_curvatures_of_both_signs_and_the_origin_none() {
         let f = field(&[1.0, 1.0, -1.0, 0.0, 0.0, 0.0]);
         let s = LocalShape::at::<f64, _>(&f, [1.0, 0.0, 0.0]).expect("regular point");
-        assert!(s.curvatures[0] * s.curvatures[1] < 0.0, "{:?}", s.curvatures);
+        assert!(
+            s.curvatures[0] * s.curvatures[1] < 0.0,
+            "{:?}",
+            s.curvatures
+        );
         assert!(LocalShape::at::<f64, _>(&f, [0.0, 0.0, 0.0]).is_none());
     }
 

@@ -62,7 +62,11 @@ impl QualityReport {
             && invariant.rows()[1][..3].iter().any(|&x| x != 0.0);
         QualityReport {
             shape: Shape::of(mesh),
-            steps: step_quality(&field, samples, (params.beta_min, params.beta_max)),
+            steps: step_quality(
+                &field,
+                samples,
+                (params.beta_min.radians(), params.beta_max.radians()),
+            ),
             face_normal_error_max: face_max,
             face_normal_error_mean: face_mean,
             topology: Topology::of(mesh),

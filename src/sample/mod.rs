@@ -13,7 +13,7 @@ mod grid;
 use crate::error::MeshError;
 use crate::geom::vec3::{dist, dot, sub};
 use crate::mesh::Provenance;
-use crate::params::{MeshParams, Method, Mode};
+use crate::params::{MeshParams, Method, Mode, Resolved};
 use crate::scalar::{Scalar, Vec3};
 use crate::trace::{self, StepConfig, StepLimit};
 use crate::NormalField;
@@ -39,6 +39,24 @@ pub enum CurveEnd {
     /// A budget ran out: points, steps per curve, or Newton's iterations for a chord at
     /// every length tried ([`StepStop::NoChord`](crate::trace::StepStop::NoChord)).
     Budget,
+}
+
+/// How many curves ended for each reason.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+pub struct CurveEnds {
+    /// At the maximum geodesic radius.
+    pub radius: usize,
+    /// Leaving the bounding box.
+    pub bounding_box: usize,
+    /// Running onto the surface other curves swept (fronts meeting).
+    pub collision: usize,
+    /// Too close to a neighbouring curve.
+    pub merge: usize,
+    /// At a singular point.
+    pub singular: usize,
+    /// On a budget.
+    pub budget: usize,
 }
 
 /// One integral curve of the fan.
@@ -85,6 +103,24 @@ pub struct Samples<T> {
     pub frame: [[f64; 3]; 3],
     /// Whether the point budget stopped the run.
     pub hit_point_budget: bool,
+}
+
+impl<T> Samples<T> {
+    /// How many curves ended for each reason.
+    pub fn ends(&self) -> CurveEnds {
+        let mut e = CurveEnds::default();
+        for c in &self.curves {
+            *match c.end {
+                CurveEnd::Radius => &mut e.radius,
+                CurveEnd::BoundingBox => &mut e.bounding_box,
+                CurveEnd::Collision => &mut e.collision,
+                CurveEnd::Merge => &mut e.merge,
+                CurveEnd::Singular => &mut e.singular,
+                CurveEnd::Budget => &mut e.budget,
+            } += 1;
+        }
+        e
+    }
 }
 
 impl<T: Scalar> Samples<T> {
@@ -155,7 +191,14 @@ pub fn sample<T: Scalar, F: NormalField<T>>(
     field: &F,
     params: &MeshParams,
 ) -> Result<Samples<T>, MeshError> {
-    params.validate()?;
+    sample_resolved(field, &params.resolve::<T, F>(field)?)
+}
+
+/// [`sample`] with the parameters already resolved.
+pub(crate) fn sample_resolved<T: Scalar, F: NormalField<T>>(
+    field: &F,
+    params: &Resolved,
+) -> Result<Samples<T>, MeshError> {
     let cfg = StepConfig::<T>::new(params);
     let p0 = Vec3::<T>::from_f64(params.p0);
     let v0 = field.normal(&p0);
@@ -176,8 +219,8 @@ pub fn sample<T: Scalar, F: NormalField<T>>(
     let frame = [e1.to_f64(), e2.to_f64(), n0.to_f64()];
 
     let thetas: Vec<f64> = match params.method {
-        Method::Previous { curves } => (0..curves)
-            .map(|j| std::f64::consts::TAU * j as f64 / curves as f64)
+        Method::Previous => (0..params.curves)
+            .map(|j| std::f64::consts::TAU * j as f64 / params.curves as f64)
             .collect(),
         // Step 2: first points p0 + Δt w at least Δt apart ⇔ directions at least 60° apart.
         Method::Proposed => (0..6)
@@ -259,7 +302,7 @@ pub fn sample<T: Scalar, F: NormalField<T>>(
 
 struct Sampler<'a, T, F> {
     field: &'a F,
-    params: &'a MeshParams,
+    params: &'a Resolved,
     cfg: StepConfig<T>,
     out: Samples<T>,
     /// `f64` copies of the points for the geometric tests.
@@ -286,7 +329,7 @@ impl<T: Scalar, F: NormalField<T>> Sampler<'_, T, F> {
     }
 
     fn run(&mut self) {
-        let budget = &self.params.budget;
+        let budget = &**self.params;
         // Every pass either adds a point or ends a curve, so this bound is never the binding
         // one; it is here so that the loop visibly terminates.
         let max_passes = budget.max_points + 2 * budget.max_curves + 16;
@@ -330,12 +373,12 @@ impl<T: Scalar, F: NormalField<T>> Sampler<'_, T, F> {
     /// One step of curve `c`; `Some(reason)` ends the curve.
     fn advance(&mut self, c: u32) -> Option<CurveEnd> {
         let ci = c as usize;
-        let budget = self.params.budget;
+        let budget = &**self.params;
         if self.out.points.len() >= budget.max_points {
             self.out.hit_point_budget = true;
             return Some(CurveEnd::Budget);
         }
-        if self.out.curves[ci].points.len() > budget.max_steps_per_curve {
+        if self.out.curves[ci].points.len() > budget.max_steps {
             return Some(CurveEnd::Budget);
         }
         let live = &self.live[ci];
@@ -351,15 +394,15 @@ impl<T: Scalar, F: NormalField<T>> Sampler<'_, T, F> {
         // grows without bound there, and the next step would jump across it.
         if step.limit == StepLimit::Clamped
             && len <= self.params.dt_min * (1.0 + 1e-9)
-            && step.alpha_predicted > SINGULAR_TURN * self.params.beta_max
+            && step.alpha_predicted > SINGULAR_TURN * self.params.beta_max.radians()
         {
             return Some(CurveEnd::Singular);
         }
         let s_new = live.s + len;
-        if s_new > self.params.terminal.max_radius {
+        if s_new > self.params.max_radius {
             return Some(CurveEnd::Radius);
         }
-        let bb = self.params.terminal.bounding_box;
+        let bb = self.params.bounding_box;
         if q.iter().any(|x| x.abs() > bb) {
             return Some(CurveEnd::BoundingBox);
         }
@@ -368,7 +411,7 @@ impl<T: Scalar, F: NormalField<T>> Sampler<'_, T, F> {
         let chart_q = [s_new * dir[0], s_new * dir[1]];
         let drift = live.drift + 0.5 * len * step.alpha_predicted;
         let normal = (!self.drift.is_empty()).then(|| step.normal.to_f64());
-        if self.params.terminal.close
+        if self.params.close
             && match normal {
                 // Paper mode: curves drift off the surface, by different amounts.
                 Some(_) => self.collides(q, chart_q, len, normal, drift),
@@ -445,11 +488,16 @@ impl<T: Scalar, F: NormalField<T>> Sampler<'_, T, F> {
                 // Apart by more than `gap` steps, or with normals turned apart by more than
                 // `gap` times the band's top: where a curve runs along a flat direction its
                 // steps are long, and only the normals tell that its neighbours diverge.
-                let last_k = *self.out.curves[k as usize].points.last().expect("curves start with one point");
-                let turn = dot(self.nrm[index as usize], self.nrm[last_k as usize]).clamp(-1.0, 1.0).acos();
+                let last_k = *self.out.curves[k as usize]
+                    .points
+                    .last()
+                    .expect("curves start with one point");
+                let turn = dot(self.nrm[index as usize], self.nrm[last_k as usize])
+                    .clamp(-1.0, 1.0)
+                    .acos();
                 if gap > self.params.gap * len
                     || (gap > self.params.merge * len.min(self.params.dt_max) * 2.0
-                        && turn > self.params.gap * self.params.beta_max)
+                        && turn > self.params.gap * self.params.beta_max.radians())
                 {
                     self.insert_between(c, k, side_right, q, target, s_target, len);
                 }
@@ -608,7 +656,7 @@ impl<T: Scalar, F: NormalField<T>> Sampler<'_, T, F> {
         } else {
             (tc - tk).rem_euclid(TAU)
         };
-        if span < 1e-9 || self.out.points.len() >= self.params.budget.max_points {
+        if span < 1e-9 || self.out.points.len() >= self.params.max_points {
             return;
         }
         let theta = if k_is_right {
@@ -630,8 +678,8 @@ impl<T: Scalar, F: NormalField<T>> Sampler<'_, T, F> {
         let start_f = start.to_f64();
         let s = 0.5 * (self.live[c as usize].s + s_target);
         // The terminal conditions hold for inserted points as for stepped ones.
-        let bb = self.params.terminal.bounding_box;
-        if s > self.params.terminal.max_radius || start_f.iter().any(|x| x.abs() > bb) {
+        let bb = self.params.bounding_box;
+        if s > self.params.max_radius || start_f.iter().any(|x| x.abs() > bb) {
             return;
         }
         let chart_dir = [theta.cos(), theta.sin()];
@@ -642,7 +690,7 @@ impl<T: Scalar, F: NormalField<T>> Sampler<'_, T, F> {
         };
         let start_normal = start_normal.to_f64();
         let normal = (!self.drift.is_empty()).then_some(start_normal);
-        if self.params.terminal.close
+        if self.params.close
             && match normal {
                 Some(_) => self.collides(start_f, chart, len, normal, drift),
                 None => self.crosses(start_f, start_f, chart, len),

@@ -22,9 +22,10 @@ mod relax;
 mod stitch;
 mod untangle;
 
-pub(crate) use refine::refine;
+pub(crate) use refine::{faces_over, refine};
 pub use refine::{Refinement, MAX_REFINE_ROUNDS};
 pub(crate) use relax::relax;
+pub(crate) use stitch::unpinch;
 pub use stitch::Stitched;
 pub(crate) use untangle::{drop_unused, keep_main_component, untangle, Before};
 pub use untangle::{Untangled, UNTANGLE_ROUNDS};
@@ -34,11 +35,9 @@ pub(crate) use crate::mesh::octahedron;
 pub use crate::mesh::{Mesh, Provenance};
 
 use crate::error::MeshError;
-use crate::geom::vec3::{
-    cross as cross3, dist as dist3, sub as sub3,
-};
+use crate::geom::vec3::{cross as cross3, dist as dist3, sub as sub3};
 use crate::model::LocalShape;
-use crate::params::MeshParams;
+use crate::params::Resolved;
 use crate::sample::{CurveEnd, Samples};
 use crate::scalar::{Scalar, Vec3};
 use crate::trace::StepConfig;
@@ -132,11 +131,7 @@ pub fn triangulate<T: Scalar>(
     ))
 }
 
-/// A field whose [integrability defect](crate::model::LocalShape::integrability_defect) stays
-/// below this at the probed samples is integrable for the stitching (rounding leaves about
-/// 1e-16 on the model's integrable fields; a rotation of 0.001 rad leaves 1e-3).
-const INTEGRABLE_DEFECT: f64 = 1e-9;
-
+use crate::model::INTEGRABLE_DEFECT;
 
 /// Stitches the chart mesh where its fronts meet (see the `stitch` module): triangles
 /// between boundary parts that face each other and, on an integrable field, new vertices on
@@ -144,25 +139,27 @@ const INTEGRABLE_DEFECT: f64 = 1e-9;
 /// precision and grows with it.
 pub(crate) fn stitch<T: Scalar, F: NormalField<T>>(
     field: &F,
-    params: &MeshParams,
+    params: &Resolved,
     samples: &Samples<T>,
     mesh: &mut Mesh,
     vertices: &mut Vec<Vec3<T>>,
 ) -> Stitched {
-    // Vertices on a boundary the surface does not close across: ends of curves that ended on
-    // a terminal condition, a singular point or a budget.
-    let free: Vec<bool> = mesh
+    // Ends of curves that ended on a terminal condition, a singular point or a budget.
+    let rim: Vec<stitch::Rim> = mesh
         .provenance
         .iter()
         .map(|pr| {
             let Some(curve) = samples.curves.get(pr.curve as usize) else {
-                return false;
+                return stitch::Rim::Open;
             };
-            pr.step as usize + 1 == curve.points.len()
-                && matches!(
-                    curve.end,
-                    CurveEnd::Radius | CurveEnd::BoundingBox | CurveEnd::Singular | CurveEnd::Budget
-                )
+            if pr.step as usize + 1 != curve.points.len() {
+                return stitch::Rim::Open;
+            }
+            match curve.end {
+                CurveEnd::Radius | CurveEnd::BoundingBox => stitch::Rim::Terminal,
+                CurveEnd::Singular | CurveEnd::Budget => stitch::Rim::Barren,
+                CurveEnd::Collision | CurveEnd::Merge => stitch::Rim::Open,
+            }
         })
         .collect();
     // New points only on an integrable field: checked at p0 and at samples spread over the
@@ -176,12 +173,12 @@ pub(crate) fn stitch<T: Scalar, F: NormalField<T>>(
     let growth = stitch::Growth {
         field,
         cfg: StepConfig::new(params),
-        bounding_box: params.terminal.bounding_box,
-        max_radius: params.terminal.max_radius,
-        max_vertices: params.budget.max_points,
+        bounding_box: params.bounding_box,
+        max_radius: params.max_radius,
+        max_vertices: params.max_points,
         new_points: integrable,
     };
-    stitch::stitch(mesh, vertices, &free, &growth)
+    stitch::stitch(mesh, vertices, &rim, &growth)
 }
 
 /// Chart triangles whose normal is further than this from their corners' field normals are

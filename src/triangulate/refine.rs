@@ -20,7 +20,7 @@ use super::flip::{against_field, agreement_at, HalfEdges};
 use super::relax::{towards_centroid, DAMPING, MIN_AGREEMENT};
 use super::{Mesh, Provenance};
 use crate::par;
-use crate::params::MeshParams;
+use crate::params::Resolved;
 use crate::quality::face_error_deg;
 use crate::scalar::{Scalar, Vec3};
 use crate::trace::{self, StepConfig};
@@ -41,7 +41,7 @@ const MAX_PATH: usize = 64;
 /// let sphere = Invariant::from_numbers(&[1.0, 1.0, 1.0, 0.0, 0.0, 0.0])?;
 /// let field = LieField::<f64>::new(&sphere);
 /// let mut params = Preset::Fig3.params();
-/// params.max_normal_error = Some(1f64.to_radians());
+/// params.max_normal_error = Some(liemesh::Angle::from_degrees(1.0));
 /// let run = liemesh::run(&field, &params)?;
 /// let refinement = run.refinement.expect("asked for");
 /// assert!(refinement.added > 0 && refinement.over_limit == 0);
@@ -61,13 +61,36 @@ pub struct Refinement {
     pub over_limit: usize,
 }
 
+/// How many faces of `mesh` have a normal error above `limit_deg`, measured as [`refine`]
+/// measures it (faces removed after refinement, when crossings are undone, no longer count).
+pub(crate) fn faces_over<T: Scalar, F: NormalField<T>>(
+    field: &F,
+    mesh: &Mesh,
+    limit_deg: f64,
+) -> usize {
+    let fast = field.in_f64();
+    let normal_at = |c: &Vec3<f64>| match fast {
+        Some(f) => f.normal(c),
+        None => Vec3::from_f64(field.normal(&Vec3::<T>::from_f64(c.to_f64())).to_f64()),
+    };
+    par::map(mesh.triangles.len(), par::MIN_COSTLY, |t| {
+        face_error_deg(
+            mesh.triangles[t].map(|i| mesh.vertices[i as usize]),
+            normal_at,
+        )
+    })
+    .into_iter()
+    .filter(|&e| e > limit_deg)
+    .count()
+}
+
 /// Splits the faces of `mesh` whose normal error exceeds `limit_deg` until none does, or the
-/// rounds or `params.budget.max_points` run out. `pos` holds the vertices in the working
+/// rounds or `params.max_points` run out. `pos` holds the vertices in the working
 /// precision and grows with the mesh. A mesh that is not a consistently oriented 2-manifold
 /// is left as it is.
 pub(crate) fn refine<T: Scalar, F: NormalField<T>>(
     field: &F,
-    params: &MeshParams,
+    params: &Resolved,
     limit_deg: f64,
     mesh: &mut Mesh,
     pos: &mut Vec<Vec3<T>>,
@@ -111,7 +134,7 @@ pub(crate) fn refine<T: Scalar, F: NormalField<T>>(
     let mut star = Vec::new();
     let mut marks = Marks::default();
     for round in 0..MAX_REFINE_ROUNDS {
-        if done.over_limit == 0 || vertices.len() >= params.budget.max_points {
+        if done.over_limit == 0 || vertices.len() >= params.max_points {
             break;
         }
         let mut bad: Vec<u32> = (0..errors.len() as u32)
@@ -128,7 +151,7 @@ pub(crate) fn refine<T: Scalar, F: NormalField<T>>(
         let mut changed: Vec<u32> = Vec::new();
         let mut added: Vec<u32> = Vec::new();
         for t in bad {
-            if vertices.len() >= params.budget.max_points {
+            if vertices.len() >= params.max_points {
                 break;
             }
             if stale.get(t as usize) != Some(&false) {
@@ -433,6 +456,7 @@ mod tests {
     use crate::preset::Preset;
     use crate::quality::{face_normal_error, Topology};
     use crate::scalar::Dual;
+    use crate::{Angle, MeshParams};
 
     fn sphere() -> Invariant {
         Invariant::from_numbers(&[1.0, 1.0, 1.0, 0.0, 0.0, 0.0]).unwrap()
@@ -441,16 +465,14 @@ mod tests {
     /// fig3 (2,006 faces, the largest normal error 2.5°) with refinement to `limit_deg`.
     fn coarse_sphere(limit_deg: f64) -> MeshParams {
         let mut params = Preset::Fig3.params();
-        params.max_normal_error = Some(limit_deg.to_radians());
+        params.max_normal_error = Some(Angle::from_degrees(limit_deg));
         params
     }
 
     /// The sphere meshed with `params` but without refinement.
     fn without_refinement(field: &LieField<f64>, params: &MeshParams) -> crate::MeshRun<f64> {
-        let params = MeshParams {
-            max_normal_error: None,
-            ..params.clone()
-        };
+        let mut params = params.clone();
+        params.max_normal_error = None;
         crate::run(field, &params).unwrap()
     }
 
@@ -487,8 +509,8 @@ mod tests {
     fn an_open_cap_is_refined_up_to_its_rim_which_stays_in_place() {
         let field = LieField::<f64>::new(&sphere());
         let mut params = coarse_sphere(1.0);
-        params.terminal.close = false;
-        params.terminal.max_radius = 1.2;
+        params.close = false;
+        params.max_radius = Some(1.2);
         let unrefined = without_refinement(&field, &params);
         let run = crate::run(&field, &params).unwrap();
         let done = run.refinement.unwrap();
@@ -531,10 +553,12 @@ mod tests {
         let field = LieField::<f64>::new(&sphere());
         let mut params = coarse_sphere(0.3);
         let unrefined = without_refinement(&field, &params);
-        params.budget.max_points = unrefined.samples.points.len() + 40;
+        // The budget counts mesh vertices, which stitching and validation make differ from
+        // the sample points: 40 more than the mesh refinement starts from.
+        params.max_points = unrefined.mesh.vertices.len() + 40;
         let run = crate::run(&field, &params).unwrap();
         let done = run.refinement.unwrap();
-        assert_eq!(run.mesh.vertices.len(), params.budget.max_points);
+        assert_eq!(run.mesh.vertices.len(), params.max_points);
         assert!(done.added == 40 && done.over_limit > 0, "{done:?}");
     }
 

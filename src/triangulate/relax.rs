@@ -9,7 +9,7 @@
 use super::flip::{agreement_at, flip_to_surface_delaunay};
 use super::{rows_by_corner, Mesh};
 use crate::par;
-use crate::params::MeshParams;
+use crate::params::Resolved;
 use crate::scalar::{Scalar, Vec3};
 use crate::trace::{self, StepConfig};
 use crate::NormalField;
@@ -23,7 +23,7 @@ pub(super) const DAMPING: f64 = 0.5;
 /// Relaxes `mesh`, whose vertices in the working precision are `vertices` (moved in place).
 pub(crate) fn relax<T: Scalar, F: NormalField<T>>(
     field: &F,
-    params: &MeshParams,
+    params: &Resolved,
     mesh: &mut Mesh,
     vertices: &mut Vec<Vec3<T>>,
 ) {
@@ -80,8 +80,7 @@ pub(crate) fn relax<T: Scalar, F: NormalField<T>>(
     // Each face's agreement with the field at the current positions, carried from one
     // sweep's check to the next sweep's starting point.
     let mut agreement: Option<Vec<f64>> = None;
-    let sweeps = if std::env::var("NOMOVE").is_ok() { 0 } else { SWEEPS };
-    for _ in 0..sweeps {
+    for _ in 0..SWEEPS {
         let moved: Vec<Vec3<T>> = par::map(n, par::MIN_COSTLY, |v| {
             if fixed[v] {
                 return pos[v].clone();

@@ -40,6 +40,8 @@ use std::collections::{BinaryHeap, HashMap, HashSet};
 pub(crate) const REACH: f64 = 2.2;
 /// Boundary loops of at most this many edges left after stitching are closed if they can be.
 pub(crate) const SMALL_HOLE: usize = 12;
+/// The longest loop left after ear clipping that is filled by a fan around a new point.
+const FAN_HOLE: usize = 6;
 /// A triangle with an angle below this many degrees closing a small hole is a sliver whose
 /// normal is not tested.
 const SLIVER_DEG: f64 = 3.0;
@@ -54,6 +56,8 @@ const NEW_POINT_SCORE: f64 = 0.45;
 const HOVER: f64 = 0.4;
 /// A new point's field normal must be within 45° of its edge's.
 const NEW_POINT_TURN_COS: f64 = std::f64::consts::FRAC_1_SQRT_2;
+/// Other vertices of a loop keep this fraction of an ear's longest edge away from it.
+const EAR_CLEARANCE: f64 = 0.02;
 /// Candidates examined per boundary edge: the nearest ones.
 const MAX_CANDIDATES: usize = 24;
 /// Smallest angle of a stitched triangle, degrees.
@@ -80,11 +84,23 @@ pub struct Stitched {
 
 type EdgeMap<V> = HashMap<(u32, u32), V, FastHash>;
 
+/// Where a vertex stands with respect to the surface's own boundary.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum Rim {
+    /// Not at the end of a curve that ended on a boundary.
+    Open,
+    /// The end of a curve that reached the geodesic radius or the bounding box: the surface
+    /// ends near it, but new points within the terminal conditions may still go beside it.
+    Terminal,
+    /// The end of a curve at a singular point or on a budget: no new point goes beside it.
+    Barren,
+}
+
 /// A removed triangle, until the end of the stitching.
 const DEAD: [u32; 3] = [u32::MAX; 3];
 
 /// Times the stitching opens holes that stayed open and runs again.
-const REDO_ROUNDS: usize = 3;
+const REDO_ROUNDS: usize = 5;
 /// Holes of at most this many edges are opened and stitched again.
 const REDO_HOLE: usize = 48;
 
@@ -136,21 +152,35 @@ pub(crate) struct Growth<'f, T, F> {
 /// Stitches the boundary of `mesh` (triangles counter-clockwise about the field normals) to
 /// itself where it faces itself, adding vertices on the surface where a gap has none to
 /// connect; see the module docs. `work` holds the vertices in the working precision and
-/// grows with them; `free[v]` marks vertices on a boundary the surface does not close across
+/// grows with them; `rim[v]` says whether vertex `v` ended a curve on a terminal condition or
+/// where the surface cannot be continued
 /// (a geodesic radius, the bounding box, a singular point, a budget): no new point is placed
 /// beyond those.
 pub(crate) fn stitch<T: Scalar, F: NormalField<T>>(
     mesh: &mut Mesh,
     work: &mut Vec<Vec3<T>>,
-    free: &[bool],
+    rim: &[Rim],
     growth: &Growth<'_, T, F>,
 ) -> Stitched {
-    let mut s = Stitcher::new(mesh, work, free, growth);
+    let mut s = Stitcher::new(mesh, work, rim, growth);
     let mut out = Stitched::default();
+    // The vertices whose boundary edges the next round looks at (all, at first; around the
+    // holes that were opened, later).
+    let mut opened: Option<HashSet<u32, FastHash>> = None;
     for round in 0..=REDO_ROUNDS {
         let budget = 8 * s.boundary_edges() + 64;
-        s.rejected.clear();
-        for (a, b) in s.boundary_edge_list() {
+        let edges: Vec<(u32, u32)> = match &opened {
+            None => s.boundary_edge_list(),
+            Some(near) => {
+                s.rejected
+                    .retain(|(a, b, _)| !near.contains(a) && !near.contains(b));
+                s.boundary_edge_list()
+                    .into_iter()
+                    .filter(|(a, b)| near.contains(a) || near.contains(b))
+                    .collect()
+            }
+        };
+        for (a, b) in edges {
             s.refresh(a, b);
         }
         let mut steps = 0;
@@ -164,7 +194,6 @@ pub(crate) fn stitch<T: Scalar, F: NormalField<T>>(
                 break;
             }
             steps += 1;
-            POPS.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
             // A new point goes in on trial: the tests read it like any vertex.
             let x = if c.x == NEW {
                 s.place_new_point(c.a, c.b)
@@ -190,35 +219,53 @@ pub(crate) fn stitch<T: Scalar, F: NormalField<T>>(
                 }
             }
         }
-        out.added += s.fill_small_holes();
+        let last = round == REDO_ROUNDS;
+        out.added += s.fill_holes(if last { REDO_HOLE } else { SMALL_HOLE });
         // Holes left between fronts that met (no vertex on a terminal boundary) are often
         // twisted: the triangles around them overlap it. Those triangles go, and the
         // stitching runs again on the larger hole.
         if round == REDO_ROUNDS || out.budget_hit {
             break;
         }
-        let stuck = s.stuck_loops();
+        let mut stuck = s.stuck_loops();
+        // Vertices still pinched by a bridge whose gaps did not close: opened too.
+        let touched = s.touched();
+        let pinched = pinched_fans(&s.tris, |v| {
+            touched.get(v as usize).copied().unwrap_or(false)
+        })
+        .0;
+        if !pinched.is_empty() {
+            stuck.push(pinched);
+        }
         if stuck.is_empty() {
             break;
         }
-        out.removed += s.open_around(&stuck);
+        let (removed, near) = s.open_around(&stuck, round + 1);
+        out.removed += removed;
+        opened = Some(near);
     }
-    if std::env::var("STITCH_DEBUG").is_ok() {
-        s.debug();
+    // Pinches left after the last round are cut apart (only stitched triangles' vertices can
+    // be pinched).
+    let touched = s.touched();
+    let (_, cut) = pinched_fans(&s.tris, |v| {
+        touched.get(v as usize).copied().unwrap_or(false)
+    });
+    for &f in &cut {
+        s.remove_triangle(f);
     }
-    if std::env::var("STITCH_STATS").is_ok() {
-        use std::sync::atomic::Ordering::Relaxed;
-        eprintln!("stitch: pops {} refreshes {} visits {} added {} vertices {} removed {}", POPS.load(Relaxed), REFRESHES.load(Relaxed), VISITS.load(Relaxed), out.added, out.vertices, out.removed);
-    }
+    out.removed += cut.len();
     let Stitcher {
-        pos, nrm, prov, mut tris, ..
+        pos,
+        nrm,
+        prov,
+        mut tris,
+        ..
     } = s;
     tris.retain(|t| *t != DEAD);
     mesh.vertices = pos;
     mesh.normals = nrm;
     mesh.provenance = prov;
     mesh.triangles = tris;
-    out.removed += unpinch(&mut mesh.triangles);
     out
 }
 
@@ -238,9 +285,11 @@ struct Stitcher<'a, 'f, T, F> {
     prov: Vec<Provenance>,
     work: &'a mut Vec<Vec3<T>>,
     /// Vertices on a boundary the surface does not close across.
-    free: Vec<bool>,
+    rim: Vec<Rim>,
     growth: &'a Growth<'f, T, F>,
     tris: Vec<[u32; 3]>,
+    /// How many triangles the chart gave (the rest are the stitching's).
+    initial: usize,
     /// Directed edge → triangle.
     edges: EdgeMap<u32>,
     /// Boundary edges by their source and by their target.
@@ -263,7 +312,7 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
     fn new(
         mesh: &mut Mesh,
         work: &'a mut Vec<Vec3<T>>,
-        free: &[bool],
+        rim: &[Rim],
         growth: &'a Growth<'f, T, F>,
     ) -> Self {
         let tris = std::mem::take(&mut mesh.triangles);
@@ -289,8 +338,11 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
             }
         }
         // Local scale: the mean length of the edges at each boundary vertex.
-        let mut scale: HashMap<u32, (f64, u32), FastHash> =
-            bout.keys().chain(bin.keys()).map(|&v| (v, (0.0, 0))).collect();
+        let mut scale: HashMap<u32, (f64, u32), FastHash> = bout
+            .keys()
+            .chain(bin.keys())
+            .map(|&v| (v, (0.0, 0)))
+            .collect();
         for t in &tris {
             for k in 0..3 {
                 let (a, b) = (t[k], t[(k + 1) % 3]);
@@ -309,7 +361,12 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
             .collect();
         let mut lengths: Vec<f64> = scale.values().copied().filter(|l| *l > 0.0).collect();
         lengths.sort_by(f64::total_cmp);
-        let cell = lengths.get(lengths.len() / 2).copied().unwrap_or(1.0).max(1e-300) * REACH;
+        let cell = lengths
+            .get(lengths.len() / 2)
+            .copied()
+            .unwrap_or(1.0)
+            .max(1e-300)
+            * REACH;
         let mut boundary: Vec<u32> = scale.keys().copied().collect();
         boundary.sort_unstable();
         let mut points = PointGrid::new(cell);
@@ -320,15 +377,16 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
         for (f, t) in tris.iter().enumerate() {
             faces.insert(f as u32, corners(&pos, *t));
         }
-        let mut free = free.to_vec();
-        free.resize(pos.len(), false);
+        let mut rim = rim.to_vec();
+        rim.resize(pos.len(), Rim::Open);
         Stitcher {
             pos,
             nrm,
             prov,
             work,
-            free,
+            rim,
             growth,
+            initial: tris.len(),
             tris,
             edges,
             bout,
@@ -394,9 +452,7 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
         // The nearest boundary vertices within reach, a bounded number of them: the work
         // per edge stays constant where boundary vertices crowd.
         let mut found = Vec::new();
-        REFRESHES.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
         self.points.near(mid, reach, |x| {
-            VISITS.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
             if x != a && x != b {
                 let d = dist(self.pos[x as usize], mid);
                 if d <= reach {
@@ -422,7 +478,10 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
         }
         // A new point in front of the edge, if no existing vertex makes a good enough
         // triangle there.
-        if best.is_none_or(|(s, _)| s < NEW_POINT_SCORE) && self.may_grow(a, b) && !self.rejected.contains(&(a, b, NEW)) {
+        if best.is_none_or(|(s, _)| s < NEW_POINT_SCORE)
+            && self.may_grow(a, b)
+            && !self.rejected.contains(&(a, b, NEW))
+        {
             best = Some((NEW_POINT_SCORE - 1e-9, NEW));
         }
         if let Some((score, x)) = best {
@@ -439,8 +498,8 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
     /// Whether edge `a → b` may get a new point in front of it.
     fn may_grow(&self, a: u32, b: u32) -> bool {
         self.growth.new_points
-            && !self.free[a as usize]
-            && !self.free[b as usize]
+            && self.rim[a as usize] != Rim::Barren
+            && self.rim[b as usize] != Rim::Barren
             && self.pos.len() < self.growth.max_vertices
     }
 
@@ -462,7 +521,7 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
             theta: p.theta,
         });
         self.work.push(p.point);
-        self.free.push(false);
+        self.rim.push(Rim::Open);
         Some(v)
     }
 
@@ -472,14 +531,15 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
         self.nrm.pop();
         self.prov.pop();
         self.work.pop();
-        self.free.pop();
+        self.rim.pop();
     }
 
     /// Keeps the vertex on trial `v`, placed for edge `a → b`.
     fn register(&mut self, v: u32, a: u32, b: u32) {
         self.proposals.remove(&(a, b));
         let h = 0.5 * (self.local(a) + self.local(b));
-        self.scale.insert(v, h.max(dist(self.pos[a as usize], self.pos[b as usize])));
+        self.scale
+            .insert(v, h.max(dist(self.pos[a as usize], self.pos[b as usize])));
         self.points.insert(v, self.pos[v as usize]);
     }
 
@@ -489,12 +549,8 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
         let (pa, pb) = (self.pos[a as usize], self.pos[b as usize]);
         let e = sub(pb, pa);
         let len = dot(e, e).sqrt();
-        let mut n = [0.0; 3];
-        for v in [a, b] {
-            for k in 0..3 {
-                n[k] += self.nrm[v as usize][k];
-            }
-        }
+        let (na, nb) = (self.nrm[a as usize], self.nrm[b as usize]);
+        let n = [0, 1, 2].map(|k| na[k] + nb[k]);
         let right = cross(e, n);
         let rl = dot(right, right).sqrt();
         if !(rl > 0.0 && len > 0.0) {
@@ -508,9 +564,13 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
         let start = &self.work[from as usize];
         let dir = Vec3::<T>::from_f64(d);
         let length = T::from_f64(dot(d, d).sqrt());
-        let point = trace::step_fixed(self.growth.field, &self.growth.cfg, start, &dir, &length).ok()?;
+        let point =
+            trace::step_fixed(self.growth.field, &self.growth.cfg, start, &dir, &length).ok()?;
         let q = point.to_f64();
-        if !q.iter().all(|x| x.is_finite() && x.abs() <= self.growth.bounding_box) {
+        if !q
+            .iter()
+            .all(|x| x.is_finite() && x.abs() <= self.growth.bounding_box)
+        {
             return None;
         }
         let (_, normal, _) = trace::unit_normal(self.growth.field, &point).ok()?;
@@ -561,23 +621,30 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
         })
     }
 
-    /// Re-queues the boundary edges near a triangle just added: those within reach of its
-    /// corners (whose candidates may have changed).
+    /// Re-queues the boundary edges at a triangle just added: those at its corners, at their
+    /// neighbours along the boundary and within the triangle's size. Edges farther away keep their candidates; one
+    /// that the triangle spoiled fails its full test when it comes up and is looked at again.
     fn refresh_near(&mut self, a: u32, b: u32, x: u32) {
-        let mut found = Vec::new();
+        let mut around = vec![a, b, x];
         for v in [a, b, x] {
-            let p = self.pos[v as usize];
-            let h = self.local(v).max(1e-300);
-            self.points.near(p, REACH * h, |w| {
-                if dist(self.pos[w as usize], p) <= REACH * h {
-                    found.push(w);
-                }
-            });
+            around.extend(self.bout.get(&v).into_iter().flatten());
+            around.extend(self.bin.get(&v).into_iter().flatten());
         }
-        found.sort_unstable();
-        found.dedup();
+        // And the boundary vertices about as close to the triangle as its own size.
+        let c = corners(&self.pos, [a, b, x]);
+        let centre = [0, 1, 2].map(|k| (c[0][k] + c[1][k] + c[2][k]) / 3.0);
+        let size = (0..3)
+            .map(|k| dist(c[k], c[(k + 1) % 3]))
+            .fold(0.0, f64::max);
+        self.points.near(centre, size, |w| {
+            if dist(self.pos[w as usize], centre) <= size {
+                around.push(w);
+            }
+        });
+        around.sort_unstable();
+        around.dedup();
         let mut list = Vec::new();
-        for v in found {
+        for v in around {
             for &w in self.bout.get(&v).map(Vec::as_slice).unwrap_or(&[]) {
                 list.push((v, w));
             }
@@ -617,8 +684,14 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
         // A hole's last sliver (a corner almost on the opposite edge) has no normal to speak
         // of: it goes in whichever way it faces, and the flips that follow remove it.
         let sliver = min_floor == 0.0 && min_angle < SLIVER_DEG.to_radians();
+        // Against each corner's normal, not only their sum: corners on opposite sides of a
+        // thin tube sum to almost nothing, and a triangle across the tube must not pass.
+        let cos_tilt = MAX_TILT_DEG.to_radians().cos();
+        let tilted = [self.nrm[a as usize], self.nrm[b as usize], nx]
+            .iter()
+            .any(|n| dot(face, *n) < cos_tilt * (ff * dot(*n, *n)).sqrt());
         if !(ff > 0.0 && gg > 0.0)
-            || (!sliver && dot(face, field) < MAX_TILT_DEG.to_radians().cos() * (ff * gg).sqrt())
+            || (!sliver && (dot(face, field) < cos_tilt * (ff * gg).sqrt() || tilted))
         {
             return None;
         }
@@ -660,7 +733,11 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
         let p = self.pos[v as usize];
         let n = self.nrm[v as usize];
         // A tangent frame at v.
-        let helper = if n[0].abs() < 0.9 { [1.0, 0.0, 0.0] } else { [0.0, 1.0, 0.0] };
+        let helper = if n[0].abs() < 0.9 {
+            [1.0, 0.0, 0.0]
+        } else {
+            [0.0, 1.0, 0.0]
+        };
         let e1 = unit(cross(helper, n));
         let e2 = cross(n, e1);
         let angle = |q: [f64; 3]| {
@@ -703,7 +780,10 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
             return false;
         }
         let reach = REACH * self.edge_scale(a, b);
-        if self.score(a, b, x, reach, MIN_ANGLE_DEG.to_radians()).is_none() {
+        if self
+            .score(a, b, x, reach, MIN_ANGLE_DEG.to_radians())
+            .is_none()
+        {
             return false;
         }
         self.clear(a, b, x) && self.meets_nothing(a, b, x)
@@ -730,7 +810,10 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
         let h = [a, b].iter().map(|&v| self.local(v)).fold(0.0, f64::max);
         let clearance = CLEARANCE * h;
         let centre = [0, 1, 2].map(|k| (corners_t[0][k] + corners_t[1][k] + corners_t[2][k]) / 3.0);
-        let radius = (0..3).map(|k| dist(centre, corners_t[k])).fold(0.0, f64::max) + clearance;
+        let radius = (0..3)
+            .map(|k| dist(centre, corners_t[k]))
+            .fold(0.0, f64::max)
+            + clearance;
         let mut crowded = false;
         self.points.near(centre, radius, |w| {
             crowded = crowded
@@ -741,17 +824,23 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
         !crowded
     }
 
-    /// Closes the boundary loops of at most [`SMALL_HOLE`] edges that are left, ear by ear
-    /// (the best-shaped ear first), as long as the ears face the way the field does and meet
-    /// nothing: the last few triangles where fronts met may have to be thin. Returns how many
+    /// Closes the boundary loops that are left, ear by ear (the best-shaped ear first), as
+    /// long as the ears face the way the field does, meet nothing and cover no other vertex of
+    /// the loop: the last few triangles where fronts met may have to be thin. Loops of at most
+    /// [`SMALL_HOLE`] edges are closed whatever they touch; loops of up to `open_limit` edges
+    /// only if no vertex of theirs ended a curve on the surface's boundary. Returns how many
     /// triangles it added.
-    fn fill_small_holes(&mut self) -> usize {
+    fn fill_holes(&mut self, open_limit: usize) -> usize {
         let mut added = 0;
+        let limit = open_limit.max(SMALL_HOLE);
         for start in self.boundary_edge_list() {
-            let Some(mut ring) = self.loop_from(start) else {
+            let Some(mut ring) = self.loop_from(start, limit) else {
                 continue;
             };
-            while ring.len() >= 3 && ring.len() <= SMALL_HOLE {
+            if ring.len() > SMALL_HOLE && ring.iter().any(|&v| self.rim[v as usize] != Rim::Open) {
+                continue;
+            }
+            while ring.len() >= 3 {
                 let m = ring.len();
                 let mut best: Option<(f64, usize)> = None;
                 for i in 0..m {
@@ -760,11 +849,19 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
                     let Some(score) = self.score(v, w, u, f64::INFINITY, 0.0) else {
                         continue;
                     };
-                    if best.is_none_or(|(s, _)| score > s) && self.meets_nothing(v, w, u) {
+                    if best.is_none_or(|(s, _)| score > s)
+                        && self.covers_none(&ring, [w, v, u])
+                        && self.meets_nothing(v, w, u)
+                    {
                         best = Some((score, i));
                     }
                 }
                 let Some((_, i)) = best else {
+                    // No ear fits: a small loop wide against the surface's curvature (its
+                    // corners' normals far apart) takes a point on the surface in its middle.
+                    if m <= FAN_HOLE && self.fill_by_fan(&ring) {
+                        added += m;
+                    }
                     break;
                 };
                 let (u, v, w) = (ring[(i + m - 1) % m], ring[i], ring[(i + 1) % m]);
@@ -779,15 +876,93 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
         added
     }
 
-    /// The boundary loop through edge `start`, if it is a simple loop (no pinched vertex on it).
-    fn loop_from(&self, (a, b): (u32, u32)) -> Option<Vec<u32>> {
+    /// Fills loop `ring` with a fan around a new point on the surface near the loop's centre,
+    /// when every triangle of the fan passes the tests an ear would. Whether it did.
+    fn fill_by_fan(&mut self, ring: &[u32]) -> bool {
+        let m = ring.len() as f64;
+        let centre = [0, 1, 2].map(|k| ring.iter().map(|&v| self.pos[v as usize][k] / m).sum());
+        // The chord starts at the corner nearest the centre: the shortest extrapolation.
+        let Some(&from) = ring.iter().min_by(|&&u, &&v| {
+            dist(self.pos[u as usize], centre).total_cmp(&dist(self.pos[v as usize], centre))
+        }) else {
+            return false;
+        };
+        let d = sub(centre, self.pos[from as usize]);
+        let length = dot(d, d).sqrt();
+        if length.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) {
+            return false;
+        }
+        let start = &self.work[from as usize];
+        let dir = Vec3::<T>::from_f64(d);
+        let Ok(point) = trace::step_fixed(
+            self.growth.field,
+            &self.growth.cfg,
+            start,
+            &dir,
+            &T::from_f64(length),
+        ) else {
+            return false;
+        };
+        let Ok((_, normal, _)) = trace::unit_normal(self.growth.field, &point) else {
+            return false;
+        };
+        let (q, normal) = (point.to_f64(), normal.to_f64());
+        if !q.iter().chain(&normal).all(|x| x.is_finite()) {
+            return false;
+        }
+        let x = self.pos.len() as u32;
+        self.pos.push(q);
+        self.nrm.push(normal);
+        let (s, theta) = ring.iter().fold((f64::INFINITY, 0.0), |(s, th), &v| {
+            let p = &self.prov[v as usize];
+            (s.min(p.s), th + p.theta / m)
+        });
+        self.prov.push(Provenance {
+            curve: Provenance::CLOSING_CURVE,
+            step: 0,
+            s: s + length,
+            theta,
+        });
+        self.work.push(point);
+        self.rim.push(Rim::Open);
+        let n = ring.len();
+        let fits = (0..n).all(|i| {
+            let (a, b) = (ring[i], ring[(i + 1) % n]);
+            self.score(a, b, x, f64::INFINITY, 0.0).is_some() && self.meets_nothing(a, b, x)
+        });
+        if !fits {
+            self.retract();
+            return false;
+        }
+        self.register(x, ring[0], ring[1]);
+        for i in 0..n {
+            self.add([ring[(i + 1) % n], ring[i], x]);
+        }
+        true
+    }
+
+    /// Whether triangle `t` keeps clear of the other vertices of `ring` (a loop's ear must
+    /// not cover part of the loop).
+    fn covers_none(&self, ring: &[u32], t: [u32; 3]) -> bool {
+        let c = corners(&self.pos, t);
+        let size = (0..3)
+            .map(|k| dist(c[k], c[(k + 1) % 3]))
+            .fold(0.0, f64::max);
+        ring.iter()
+            .filter(|v| !t.contains(v))
+            .all(|&v| point_triangle_distance(self.pos[v as usize], c) > EAR_CLEARANCE * size)
+    }
+
+    /// The boundary loop through edge `start`, if it is a simple loop (no pinched vertex on
+    /// it) of at most `limit` edges.
+    fn loop_from(&self, (a, b): (u32, u32), limit: usize) -> Option<Vec<u32>> {
         if !self.is_boundary_edge(a, b) {
             return None;
         }
         let mut ring = vec![a];
         let mut v = b;
         while v != a {
-            if ring.len() > SMALL_HOLE {
+            if ring.len() > limit {
                 return None;
             }
             ring.push(v);
@@ -797,28 +972,6 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
             }
         }
         Some(ring)
-    }
-
-    fn debug(&self) {
-        for (a, b) in self.boundary_edge_list() {
-            let reach = REACH * self.edge_scale(a, b);
-            let (pa, pb) = (self.pos[a as usize], self.pos[b as usize]);
-            let mid = [0, 1, 2].map(|k| 0.5 * (pa[k] + pb[k]));
-            let mut found = Vec::new();
-            self.points.near(mid, reach, |x| {
-                if x != a && x != b && self.on_boundary(x) && dist(self.pos[x as usize], mid) <= reach {
-                    found.push(x);
-                }
-            });
-            found.sort_unstable();
-            found.dedup();
-            eprint!("edge {a}->{b} len {:.3} free {}{}:", dist(pa, pb), self.free[a as usize] as u8, self.free[b as usize] as u8);
-            for x in found {
-                let ok = self.score(a, b, x, reach, MIN_ANGLE_DEG.to_radians()).is_some();
-                eprint!(" [{x} {}]", if ok { if self.meets_nothing(a, b, x) { "ok" } else { "hit" } } else { "no" });
-            }
-            eprintln!();
-        }
     }
 
     /// The boundary loops that closing fronts left open: no vertex on a terminal boundary and
@@ -847,7 +1000,7 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
             }
             // A loop on a terminal boundary is stuck only if it is short: a notch that the
             // rim pinched off, not the rim itself.
-            let terminal = ring.iter().any(|&v| self.free[v as usize]);
+            let terminal = ring.iter().any(|&v| self.rim[v as usize] != Rim::Open);
             if ok && (!terminal || ring.len() <= SMALL_HOLE) {
                 out.push(ring);
             }
@@ -855,19 +1008,46 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
         out
     }
 
-    /// Removes the triangles at the vertices of `loops`; returns how many.
-    fn open_around(&mut self, loops: &[Vec<u32>]) -> usize {
-        let mark: HashSet<u32, FastHash> = loops.iter().flatten().copied().collect();
-        let doomed: Vec<u32> = (0..self.tris.len() as u32)
-            .filter(|&f| {
-                let t = self.tris[f as usize];
-                t != DEAD && t.iter().any(|v| mark.contains(v))
-            })
-            .collect();
+    /// Which vertices the stitching's triangles touch.
+    fn touched(&self) -> Vec<bool> {
+        let mut t = vec![false; self.pos.len()];
+        for tri in &self.tris[self.initial..] {
+            if *tri != DEAD {
+                for &v in tri {
+                    t[v as usize] = true;
+                }
+            }
+        }
+        t
+    }
+
+    /// Removes the triangles within `rings` rings of the vertices of `loops` (each round
+    /// opens wider: a twist the last opening did not reach may be one ring farther); returns
+    /// how many, and the vertices of the removed triangles.
+    fn open_around(&mut self, loops: &[Vec<u32>], rings: usize) -> (usize, HashSet<u32, FastHash>) {
+        let mut mark: HashSet<u32, FastHash> = loops.iter().flatten().copied().collect();
+        let mut doomed: Vec<u32> = Vec::new();
+        for ring in 0..rings {
+            doomed = (0..self.tris.len() as u32)
+                .filter(|&f| {
+                    let t = self.tris[f as usize];
+                    t != DEAD && t.iter().any(|v| mark.contains(v))
+                })
+                .collect();
+            if ring + 1 < rings {
+                // Not through the terminal boundary: the hole must stay a hole.
+                for &f in &doomed {
+                    let t = self.tris[f as usize];
+                    mark.extend(t.iter().filter(|&&v| self.rim[v as usize] == Rim::Open));
+                }
+            }
+        }
+        let mut near = mark;
         for &f in &doomed {
+            near.extend(self.tris[f as usize]);
             self.remove_triangle(f);
         }
-        doomed.len()
+        (doomed.len(), near)
     }
 
     /// Removes triangle `f` (it stays as a tombstone until the end).
@@ -954,7 +1134,11 @@ fn point_triangle_distance(p: [f64; 3], t: [[f64; 3]; 3]) -> f64 {
 fn segment_distance(p: [f64; 3], a: [f64; 3], b: [f64; 3]) -> f64 {
     let e = sub(b, a);
     let ee = dot(e, e);
-    let u = if ee > 0.0 { (dot(sub(p, a), e) / ee).clamp(0.0, 1.0) } else { 0.0 };
+    let u = if ee > 0.0 {
+        (dot(sub(p, a), e) / ee).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
     dist(p, [a[0] + u * e[0], a[1] + u * e[1], a[2] + u * e[2]])
 }
 
@@ -983,82 +1167,116 @@ fn angles([a, b, c]: [[f64; 3]; 3]) -> [f64; 3] {
 pub(crate) fn unpinch(triangles: &mut Vec<[u32; 3]>) -> usize {
     let mut removed = 0;
     for _ in 0..64 {
-        let fans = pinched_fans(triangles);
-        if fans.is_empty() {
+        let drop = pinched_fans(triangles, |_| true).1;
+        if drop.is_empty() {
             break;
         }
-        let drop: HashSet<u32, FastHash> = fans.into_iter().collect();
         let before = triangles.len();
         let mut f = 0u32;
+        let mut next = drop.iter().peekable();
         triangles.retain(|_| {
-            let keep = !drop.contains(&f);
+            let gone = next.peek() == Some(&&f);
+            if gone {
+                next.next();
+            }
             f += 1;
-            keep
+            !gone
         });
         removed += before - triangles.len();
     }
     removed
 }
 
-/// The triangles of the smaller fans at every pinched vertex.
-fn pinched_fans(triangles: &[[u32; 3]]) -> Vec<u32> {
-    // Triangles by vertex, and each triangle's neighbours across its edges at that vertex.
-    let mut by_vertex: HashMap<u32, Vec<u32>, FastHash> = HashMap::default();
-    let mut edges: EdgeMap<u32> = HashMap::default();
-    for (f, t) in triangles.iter().enumerate() {
-        for k in 0..3 {
-            by_vertex.entry(t[k]).or_default().push(f as u32);
-            edges.insert((t[k], t[(k + 1) % 3]), f as u32);
+/// The pinched vertices among those `candidate` accepts (more than one fan of triangles
+/// around them), and the triangles of all their fans but the largest (sorted). Skips
+/// [`DEAD`] triangles.
+fn pinched_fans(triangles: &[[u32; 3]], candidate: impl Fn(u32) -> bool) -> (Vec<u32>, Vec<u32>) {
+    let n = triangles
+        .iter()
+        .filter(|t| **t != DEAD)
+        .flat_map(|t| t.iter())
+        .max()
+        .map_or(0, |&m| m as usize + 1);
+    // Vertex → triangles, in compressed rows, for the candidates.
+    let mut start = vec![0u32; n + 1];
+    for t in triangles.iter().filter(|t| **t != DEAD) {
+        for &v in t {
+            if candidate(v) {
+                start[v as usize + 1] += 1;
+            }
         }
     }
-    let mut out = Vec::new();
-    let mut vertices: Vec<u32> = by_vertex.keys().copied().collect();
-    vertices.sort_unstable();
-    for v in vertices {
-        let star = &by_vertex[&v];
-        // Union of the star's triangles through shared edges at v.
-        let mut group: HashMap<u32, usize, FastHash> = HashMap::default();
-        let mut groups: Vec<Vec<u32>> = Vec::new();
-        for &f in star {
-            if group.contains_key(&f) {
-                continue;
+    for v in 0..n {
+        start[v + 1] += start[v];
+    }
+    let mut fill = start.clone();
+    let mut star = vec![0u32; start[n] as usize];
+    for (f, t) in triangles.iter().enumerate().filter(|(_, t)| **t != DEAD) {
+        for &v in t {
+            if candidate(v) {
+                star[fill[v as usize] as usize] = f as u32;
+                fill[v as usize] += 1;
             }
-            let g = groups.len();
-            groups.push(Vec::new());
-            let mut stack = vec![f];
-            group.insert(f, g);
-            while let Some(t) = stack.pop() {
-                groups[g].push(t);
-                let tri = triangles[t as usize];
-                for &w in &tri {
-                    if w == v {
-                        continue;
-                    }
-                    for e in [(v, w), (w, v)] {
-                        if let Some(&u) = edges.get(&(e.1, e.0)) {
-                            if star.contains(&u) && !group.contains_key(&u) {
-                                group.insert(u, g);
-                                stack.push(u);
-                            }
-                        }
+        }
+    }
+    let (mut pinched, mut drop) = (Vec::new(), Vec::new());
+    let mut group: Vec<usize> = Vec::new();
+    for v in 0..n {
+        let faces = &star[start[v] as usize..start[v + 1] as usize];
+        if faces.len() < 2 {
+            continue;
+        }
+        // Union of the star's triangles that share an edge at v (a second common vertex).
+        group.clear();
+        group.extend(0..faces.len());
+        fn root(g: &mut [usize], mut i: usize) -> usize {
+            while g[i] != i {
+                g[i] = g[g[i]];
+                i = g[i];
+            }
+            i
+        }
+        for i in 0..faces.len() {
+            let ti = triangles[faces[i] as usize];
+            for j in i + 1..faces.len() {
+                let tj = triangles[faces[j] as usize];
+                let shared = ti
+                    .iter()
+                    .filter(|&&w| w != v as u32 && tj.contains(&w))
+                    .count();
+                if shared > 0 {
+                    let (a, b) = (root(&mut group, i), root(&mut group, j));
+                    if a != b {
+                        group[a.max(b)] = a.min(b);
                     }
                 }
             }
         }
-        if groups.len() > 1 {
-            let largest = (0..groups.len())
-                .max_by_key(|&g| (groups[g].len(), std::cmp::Reverse(groups[g].iter().min().copied())))
-                .unwrap_or(0);
-            for (g, members) in groups.into_iter().enumerate() {
-                if g != largest {
-                    out.extend(members);
+        let roots: Vec<usize> = (0..faces.len()).map(|i| root(&mut group, i)).collect();
+        let mut sizes: Vec<(usize, usize)> = Vec::new();
+        for &r in &roots {
+            match sizes.iter_mut().find(|(g, _)| *g == r) {
+                Some(e) => e.1 += 1,
+                None => sizes.push((r, 1)),
+            }
+        }
+        if sizes.len() > 1 {
+            pinched.push(v as u32);
+            // The largest fan stays (the first of equals, by its lowest triangle).
+            let keep = sizes
+                .iter()
+                .max_by_key(|(g, c)| (*c, std::cmp::Reverse(*g)))
+                .map_or(0, |e| e.0);
+            for (i, &r) in roots.iter().enumerate() {
+                if r != keep {
+                    drop.push(faces[i]);
                 }
             }
         }
     }
-    out.sort_unstable();
-    out.dedup();
-    out
+    drop.sort_unstable();
+    drop.dedup();
+    (pinched, drop)
 }
 
 type Cell = (i32, i32, i32);
@@ -1169,6 +1387,3 @@ impl FaceGrid {
         }
     }
 }
-pub(crate) static REFRESHES: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
-pub(crate) static VISITS: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
-pub(crate) static POPS: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);

@@ -19,7 +19,7 @@ use crate::mesh::Mesh;
 use crate::scalar::{Scalar, Vec3};
 
 /// Rounds of finding crossings and undoing them.
-pub const UNTANGLE_ROUNDS: usize = 6;
+pub const UNTANGLE_ROUNDS: usize = 16;
 
 /// What untangling did.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
