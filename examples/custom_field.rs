@@ -19,12 +19,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             p.z.clone() / Dual::constant(c2),
         )
     });
-    let params = MeshParams {
-        // Start on the shortest axis, heading along the middle one.
-        p0: [1.0, 0.0, 0.0],
-        w00: [0.0, 1.0, 0.0],
-        ..MeshParams::default()
-    };
+    // Start on the shortest axis, heading along the middle one; the step lengths and the
+    // terminal conditions follow the surface's size and curvature there.
+    let mut params = MeshParams::at([1.0, 0.0, 0.0]);
+    params.w00 = Some([0.0, 1.0, 0.0]);
     let mesh = generate(&field, &params)?;
     let topology = Topology::of(&mesh);
     println!("ellipsoid x² + (y/1.5)² + (z/2)² = 1, proposed method from p0 = (1, 0, 0)");

@@ -31,7 +31,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let invariant = Invariant::from_numbers(&numbers)?;
     let mut params = Preset::Fig3.params();
     params.p0 = [0.0, 0.0, 0.25];
-    params.dt = 0.05;
+    params.dt = Some(0.05);
 
     // λ3 is number 2 of the 18-number layout.
     let dual = run(&LieField::<f64>::seeded(&invariant, 2), &params)?;

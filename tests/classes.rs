@@ -1,0 +1,542 @@
+//! One property per class of surface the model describes, meshed from default parameters
+//! only (an invariant or a field, and a point `p0` on the surface), at random sizes, shapes,
+//! orientations and starting points:
+//!
+//! | class | what every mesh must be |
+//! |---|---|
+//! | ellipsoids (any scale, any axis order) | valid, closed, χ = 2 |
+//! | elliptic cylinders along any axis | valid; a band (χ = 0, two boundary loops) in at least 85% of cases |
+//! | hyperboloids of one sheet | valid; a band (χ = 0, two boundary loops) in at least 85% of cases |
+//! | hyperboloids of two sheets | valid, one sheet: a disc |
+//! | cones | valid; one nappe (χ = 1 with one loop, or χ = 0 with two: meeting at or stopping short of the apex) in at least 85% of cases |
+//! | linear invariants with non-zero angles (non-integrable) | valid, at least 200 triangles; at most a fifth `MeshError::Empty` |
+//! | 18-number Hamiltonian invariants, entries in [−1, 1] | valid, at least 200 triangles |
+//! | 12-number Hamiltonian invariants with diagonal `A` (cubics) | valid, vertices on the level set; at most a fifth `MeshError::Empty` |
+//! | tori (a `FnField`) | valid, closed, χ = 0 (ignored: not met yet) |
+//! | tori with an elliptic tube about a tilted axis (a `FnField`) | valid, closed, χ = 0 (ignored: not met yet) |
+//!
+//! "Valid" is [`liemesh::mesh::Validation::is_valid`]: manifold, consistently oriented, no
+//! degenerate face and no self-intersection, decided exactly. The mesher itself refuses to
+//! return an invalid mesh (`MeshError::Invalid`), so the tests also check that the report
+//! agrees with a fresh validation and with [`Topology`].
+//!
+//! Cases come from a fixed seed per class so that the suite is reproducible;
+//! `PROPTEST_CASES=<n>` runs `n` cases per class and `PROPTEST_RNG_SEED=<n>` explores others.
+
+use liemesh::mesh::Mesh;
+use liemesh::model::{FnField, Invariant, LieField, NormalField};
+use liemesh::quality::Topology;
+use liemesh::scalar::{Dual, Scalar, Vec3};
+use liemesh::{run, MeshError, MeshParams, MeshRun};
+use proptest::prelude::*;
+use proptest::test_runner::{Config, RngSeed, TestCaseError, TestRunner};
+
+/// Cases per class unless `PROPTEST_CASES` says otherwise: enough to meet every class's
+/// awkward members in CI time.
+const CASES: u32 = 12;
+
+/// The points budget of the 18-number Hamiltonian cases: their swept surfaces take from
+/// milliseconds to minutes with the default budget (see docs/status.md).
+const HAMILTONIAN_POINTS: usize = 40_000;
+
+/// The share of cylinders, one-sheet hyperboloids and cones (in percent) allowed to come out
+/// valid but with the wrong topology (an extra hole left where fronts met): measured at 0–10%
+/// over random seeds, see docs/status.md. Every mesh must still be valid.
+const BAND_MISSES: u32 = 15;
+
+fn runner(seed: u64) -> TestRunner {
+    let mut config = Config {
+        failure_persistence: None,
+        // A failing case is reported as drawn: shrinking reruns the mesher hundreds of times.
+        max_shrink_iters: 0,
+        ..Config::default()
+    };
+    if config.rng_seed == RngSeed::Random {
+        config.rng_seed = RngSeed::Fixed(seed);
+    }
+    if std::env::var_os("PROPTEST_CASES").is_none() {
+        config.cases = CASES;
+    }
+    TestRunner::new(config)
+}
+
+/// What a class's meshes must look like beyond validity.
+#[derive(Clone, Copy, Debug)]
+enum Shape {
+    /// Closed, of the given Euler characteristic.
+    Closed(i64),
+    /// A band: χ = 0 and two boundary loops.
+    Band,
+    /// A disc: χ = 1, one boundary loop.
+    Disc,
+    /// One nappe of a cone: χ = 1 with one boundary loop (meeting at the apex), or an annulus
+    /// stopping short of the apex (χ = 0, two loops).
+    Nappe,
+    /// Whatever the swept surface is, as long as it has at least this many triangles.
+    Swept(usize),
+}
+
+/// Meshes `field` from `p0` with default parameters and checks validity and `shape`.
+fn check<F: NormalField<f64>>(
+    field: &F,
+    p0: [f64; 3],
+    shape: Shape,
+    what: &str,
+) -> Result<MeshRun<f64>, TestCaseError> {
+    check_with(field, MeshParams::at(p0), shape, what)
+}
+
+/// [`check`] with parameters of one's own.
+fn check_with<F: NormalField<f64>>(
+    field: &F,
+    params: MeshParams,
+    shape: Shape,
+    what: &str,
+) -> Result<MeshRun<f64>, TestCaseError> {
+    let p0 = params.p0;
+    let run =
+        run(field, &params).map_err(|e| TestCaseError::fail(format!("{what}, p0 {p0:?}: {e}")))?;
+    let mesh: &Mesh = &run.mesh;
+    let validation = mesh.validate();
+    let topology = Topology::of(mesh);
+    let context = format!(
+        "{what}, p0 {p0:?}: {} triangles, χ {}, {} boundary loops, {} components",
+        topology.faces,
+        topology.euler_characteristic,
+        topology.boundary_loops,
+        validation.components
+    );
+    prop_assert!(validation.is_valid(), "{context}: invalid: {validation}");
+    prop_assert!(run.validation.is_valid(), "{context}: report says invalid");
+    prop_assert_eq!(validation.components, 1, "{}", context);
+    prop_assert_eq!(
+        validation.euler_characteristic,
+        topology.euler_characteristic,
+        "{}",
+        context
+    );
+    // A swept (non-integrable) surface may have curves that wind on until a budget stops
+    // them, and near a cone's apex a chord may find no point; the report says so. Every
+    // other class must come out whole.
+    if !matches!(shape, Shape::Swept(_) | Shape::Nappe) {
+        prop_assert!(
+            run.cut_short().is_empty(),
+            "{context}: cut short: {:?}",
+            run.cut_short()
+        );
+    }
+    let (chi, loops) = (topology.euler_characteristic, topology.boundary_loops);
+    let fits = match shape {
+        Shape::Closed(expected) => topology.closed && chi == expected,
+        Shape::Band => chi == 0 && loops == 2,
+        Shape::Disc => chi == 1 && loops == 1,
+        Shape::Nappe => (chi == 1 && loops == 1) || (chi == 0 && loops == 2),
+        Shape::Swept(least) => topology.faces >= least,
+    };
+    if !fits {
+        if let Some(misses) = MISSES.with(|m| m.get()) {
+            // A class whose topology is not yet always right (see the module table): the
+            // miss is counted, the mesh is still valid.
+            MISSES.with(|m| m.set(Some(misses + 1)));
+            eprintln!("{context}: expected {shape:?} (counted)");
+            return Ok(run);
+        }
+    }
+    prop_assert!(fits, "{context}: expected {shape:?}");
+    Ok(run)
+}
+
+thread_local! {
+    /// Topology misses counted instead of failing, when `Some` (see [`tolerating`]).
+    static MISSES: std::cell::Cell<Option<u32>> = const { std::cell::Cell::new(None) };
+}
+
+/// Runs `body` counting topology misses instead of failing on them, and fails when more
+/// than `percent` of `cases` missed. Validity is never tolerated.
+fn tolerating(percent: u32, body: impl FnOnce() -> u32) {
+    MISSES.with(|m| m.set(Some(0)));
+    let cases = body();
+    let misses = MISSES.with(|m| m.take()).unwrap_or(0);
+    assert!(
+        misses * 100 <= percent * cases,
+        "{misses} of {cases} meshes had the wrong topology (at most {percent}% allowed)"
+    );
+}
+
+/// The largest `|F(v) − level|` over the vertices, relative to the surface's size, for the
+/// quadric `F = Σ λᵢ xᵢ²`.
+fn quadric_drift(mesh: &Mesh, lambda: [f64; 3], level: f64) -> f64 {
+    mesh.vertices
+        .iter()
+        .map(|v| ((0..3).map(|k| lambda[k] * v[k] * v[k]).sum::<f64>() - level).abs())
+        .fold(0.0, f64::max)
+}
+
+/// A linear invariant `diag(λ)` with λ permuted by `perm`.
+fn diagonal(lambda: [f64; 3]) -> LieField<f64> {
+    let numbers = [lambda[0], lambda[1], lambda[2], 0.0, 0.0, 0.0];
+    LieField::new(&Invariant::from_numbers(&numbers).expect("six numbers"))
+}
+
+/// `signs` placed on random semi-axes in [0.5, 2] times `10^scale`, in a random axis order:
+/// the quadric's λ.
+fn quadric_lambda() -> impl Strategy<Value = ([f64; 3], usize, f64)> {
+    (prop::array::uniform3(0.5f64..2.0), 0usize..3, -2.0f64..2.0)
+        .prop_map(|(axes, perm, scale)| (axes, perm, 10f64.powf(scale)))
+        .prop_map(|(axes, perm, s)| {
+            let mut l = [0.0; 3];
+            for k in 0..3 {
+                l[(k + perm) % 3] = 1.0 / (axes[k] * s).powi(2);
+            }
+            (l, perm, s)
+        })
+}
+
+/// A direction with every component in [−1, 1] and length at least 0.2.
+fn direction() -> impl Strategy<Value = [f64; 3]> {
+    prop::array::uniform3(-1.0f64..1.0).prop_filter("not too short", |d| {
+        d.iter().map(|x| x * x).sum::<f64>() > 0.04
+    })
+}
+
+/// Runs a quadric class: `signs[k]` multiplies the k-th (permuted) λ; `level` is F at p0.
+fn quadric_class(seed: u64, signs: [f64; 3], level: f64, shape: Shape, name: &str) -> u32 {
+    let strategy = (quadric_lambda(), direction()).prop_filter_map(
+        "p0 on the surface",
+        move |((l, perm, s), d)| {
+            let mut lambda = [0.0; 3];
+            for k in 0..3 {
+                lambda[(k + perm) % 3] = l[(k + perm) % 3] * signs[k];
+            }
+            let p0 = on_quadric(lambda, level, d, s)?;
+            Some((lambda, p0))
+        },
+    );
+    let mut runner = runner(seed);
+    let cases = runner.config().cases;
+    runner
+        .run(&strategy, |(lambda, p0)| {
+            let field = diagonal(lambda);
+            let run = check(&field, p0, shape, &format!("{name} λ {lambda:?}"))?;
+            // Integrable: the vertices stay on the quadric to rounding (relative to F's size).
+            let drift = quadric_drift(&run.mesh, lambda, level);
+            let size = (0..3).map(|k| lambda[k].abs() * p0[k] * p0[k]).sum::<f64>();
+            prop_assert!(drift <= 1e-9 * size.max(1e-300), "{name}: drift {drift:e}");
+            Ok(())
+        })
+        .unwrap();
+    cases
+}
+
+/// The point on `Σ λₖ xₖ² = level` along direction `d` from the origin (for a cone,
+/// `level = 0`, solved for the coordinate with negative λ), at most `3 s` from the origin.
+fn on_quadric(lambda: [f64; 3], level: f64, d: [f64; 3], s: f64) -> Option<[f64; 3]> {
+    let q: f64 = (0..3).map(|k| lambda[k] * d[k] * d[k]).sum();
+    let p = if level == 0.0 {
+        let neg = (0..3).find(|&k| lambda[k] < 0.0)?;
+        let rest: f64 = (0..3)
+            .filter(|&k| k != neg)
+            .map(|k| lambda[k] * d[k] * d[k])
+            .sum();
+        let mut p = d.map(|x| x * s);
+        p[neg] = s * (rest / -lambda[neg]).sqrt().copysign(d[neg]);
+        p
+    } else {
+        // Away from the asymptotic directions, where p0 would be far out.
+        if q * level < 0.05 * (0..3).map(|k| lambda[k].abs() * d[k] * d[k]).sum::<f64>() {
+            return None;
+        }
+        let t = (level / q).sqrt();
+        d.map(|x| x * t)
+    };
+    let r = p.iter().map(|x| x * x).sum::<f64>().sqrt();
+    (r <= 3.0 * s && r >= 0.2 * s && p.iter().all(|x| x.is_finite())).then_some(p)
+}
+
+#[test]
+fn ellipsoids_close_with_euler_characteristic_two() {
+    quadric_class(0xe11, [1.0, 1.0, 1.0], 1.0, Shape::Closed(2), "ellipsoid");
+}
+
+#[test]
+fn cylinders_along_any_axis_are_bands() {
+    tolerating(BAND_MISSES, || {
+        quadric_class(0xc71, [1.0, 1.0, 0.0], 1.0, Shape::Band, "cylinder")
+    });
+}
+
+#[test]
+fn one_sheet_hyperboloids_are_bands() {
+    tolerating(BAND_MISSES, || {
+        quadric_class(
+            0x4791,
+            [1.0, 1.0, -1.0],
+            1.0,
+            Shape::Band,
+            "one-sheet hyperboloid",
+        )
+    });
+}
+
+#[test]
+fn two_sheet_hyperboloids_are_one_disc() {
+    quadric_class(
+        0x4792,
+        [-1.0, -1.0, 1.0],
+        1.0,
+        Shape::Disc,
+        "two-sheet hyperboloid",
+    );
+}
+
+#[test]
+fn cones_are_one_nappe() {
+    tolerating(BAND_MISSES, || {
+        quadric_class(0xc0e, [1.0, 1.0, -1.0], 0.0, Shape::Nappe, "cone")
+    });
+}
+
+#[test]
+fn non_integrable_linear_invariants_sweep_an_embedded_surface() {
+    let angle = (-1.0f64..1.0).prop_filter("non-zero", |a: &f64| a.abs() > 0.05);
+    let strategy = (
+        prop::array::uniform3(0.3f64..3.0),
+        (angle.clone(), angle.clone(), angle),
+        direction(),
+    );
+    let empty = std::cell::Cell::new(0u32);
+    let mut runner = runner(0x11e);
+    let cases = runner.config().cases;
+    runner
+        .run(&strategy, |(lambda, (theta, phi, psi), p0)| {
+            let numbers = [lambda[0], lambda[1], lambda[2], theta, phi, psi];
+            let field = LieField::new(&Invariant::from_numbers(&numbers).expect("six numbers"));
+            // Where the swept surface folds right at p0, no triangle survives: a typed
+            // error, counted below.
+            if let Err(MeshError::Empty { .. }) = run(&field, &MeshParams::at(p0)) {
+                empty.set(empty.get() + 1);
+                return Ok(());
+            }
+            check(
+                &field,
+                p0,
+                Shape::Swept(200),
+                &format!("linear {numbers:?}"),
+            )?;
+            Ok(())
+        })
+        .unwrap();
+    assert!(
+        empty.get() * 5 <= cases,
+        "{} of {cases} fields gave no mesh (at most a fifth allowed)",
+        empty.get()
+    );
+}
+
+#[test]
+fn hamiltonian_invariants_sweep_an_embedded_surface() {
+    let strategy = (prop::collection::vec(-1.0f64..1.0, 18), direction());
+    runner(0x4a1)
+        .run(&strategy, |(numbers, p0)| {
+            let field = LieField::new(&Invariant::from_numbers(&numbers).expect("18 numbers"));
+            // A points budget bounds the time of the slow ones (a run cut short says so,
+            // and must still be valid and large enough).
+            let mut params = MeshParams::at(p0);
+            params.max_points = HAMILTONIAN_POINTS;
+            check_with(
+                &field,
+                params,
+                Shape::Swept(200),
+                &format!("Hamiltonian {numbers:?}"),
+            )?;
+            Ok(())
+        })
+        .unwrap();
+}
+
+#[test]
+fn hamiltonian_cubics_stay_on_their_level_set() {
+    // λ11 λ12 λ13 λ21 λ22 λ23 λ31 λ32 λ33 θ1 φ1 ψ1 with θ1 = φ1 = ψ1 = 0: A, B, C diagonal.
+    let strategy = (prop::collection::vec(-1.0f64..1.0, 9), direction());
+    let empty = std::cell::Cell::new(0u32);
+    let mut runner = runner(0xc0b);
+    let cases = runner.config().cases;
+    runner
+        .run(&strategy, |(lambdas, p0)| {
+            let mut numbers = lambdas.clone();
+            numbers.extend([0.0; 3]);
+            let invariant = Invariant::from_numbers(&numbers).expect("12 numbers");
+            let field = LieField::<f64>::new(&invariant);
+            // Where the chart of the samples folds right at p0, no triangle survives: a typed
+            // error, counted below.
+            if let Err(MeshError::Empty { .. }) = run(&field, &MeshParams::at(p0)) {
+                empty.set(empty.get() + 1);
+                return Ok(());
+            }
+            let run = check(&field, p0, Shape::Swept(1), &format!("cubic {numbers:?}"))?;
+            // The field is the gradient of a cubic; the mesh must stay on p0's level set,
+            // which we read from the normal field's potential along straight paths: compare
+            // the line integral of the normal from p0 to each vertex with zero.
+            let worst = run
+                .mesh
+                .vertices
+                .iter()
+                .map(|v| line_integral(&field, p0, *v).abs())
+                .fold(0.0, f64::max);
+            let scale = norm(field.normal(&Vec3::new(p0[0], p0[1], p0[2])));
+            prop_assert!(
+                worst <= 1e-7 * scale.max(1.0),
+                "cubic: level drift {worst:e}"
+            );
+            Ok(())
+        })
+        .unwrap();
+    assert!(
+        empty.get() * 5 <= cases,
+        "{} of {cases} cubics gave no mesh (at most a fifth allowed)",
+        empty.get()
+    );
+}
+
+fn norm(v: Vec3<f64>) -> f64 {
+    (v.x * v.x + v.y * v.y + v.z * v.z).sqrt()
+}
+
+/// `∫ n · dx` along the straight segment from `a` to `b` (Gauss–Legendre, 8 points per
+/// piece, 16 pieces): the potential difference for a gradient field of a cubic, exact up to
+/// rounding since the integrand is a polynomial of degree 2 in the parameter.
+fn line_integral<F: NormalField<f64>>(field: &F, a: [f64; 3], b: [f64; 3]) -> f64 {
+    // Two-point Gauss–Legendre is exact for degree ≤ 3.
+    let nodes = [0.5 - 0.5 / 3f64.sqrt(), 0.5 + 0.5 / 3f64.sqrt()];
+    let d = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
+    nodes
+        .iter()
+        .map(|&t| {
+            let p = Vec3::new(a[0] + t * d[0], a[1] + t * d[1], a[2] + t * d[2]);
+            let n = field.normal(&p);
+            0.5 * (n.x * d[0] + n.y * d[1] + n.z * d[2])
+        })
+        .sum()
+}
+
+/// The gradient (halved) of `((ρ − R)/a)² + (z/b)²` with `ρ = √(x² + y²)`, in coordinates
+/// turned by `tilt` about the x axis: a torus with an elliptic tube (`a = b`: a round one).
+fn torus_field<T: Scalar>(
+    big: f64,
+    a: f64,
+    b: f64,
+    tilt: f64,
+) -> impl Fn(&Vec3<Dual<T>>) -> Vec3<Dual<T>> + Sync {
+    let (c, s) = (tilt.cos(), tilt.sin());
+    move |p: &Vec3<Dual<T>>| {
+        let k = |x: f64| Dual::constant(T::from_f64(x));
+        // Body coordinates: (x, y', z') = (x, c y + s z, −s y + c z).
+        let x = p.x.clone();
+        let y = k(c) * p.y.clone() + k(s) * p.z.clone();
+        let z = k(-s) * p.y.clone() + k(c) * p.z.clone();
+        let rho = (x.clone() * x.clone() + y.clone() * y.clone()).sqrt();
+        let radial = (rho.clone() - k(big)) / (k(a * a) * rho);
+        let (gx, gy, gz) = (radial.clone() * x, radial * y, z / k(b * b));
+        // Back to world coordinates (the transpose of the turn).
+        Vec3::new(
+            gx,
+            k(c) * gy.clone() - k(s) * gz.clone(),
+            k(s) * gy + k(c) * gz,
+        )
+    }
+}
+
+/// The point at tube angle `v` and around-angle `u` on the torus of [`torus_field`].
+fn on_torus(big: f64, a: f64, b: f64, tilt: f64, u: f64, v: f64) -> [f64; 3] {
+    let rho = big + a * v.cos();
+    let (x, y, z) = (rho * u.cos(), rho * u.sin(), b * v.sin());
+    let (c, s) = (tilt.cos(), tilt.sin());
+    [x, c * y - s * z, s * y + c * z]
+}
+
+fn torus_class(seed: u64, elliptic: bool) {
+    let tau = std::f64::consts::TAU;
+    let strategy = (
+        1.5f64..4.0,
+        0.25f64..0.6,
+        0.5f64..1.5,
+        -2.0f64..2.0,
+        0.0f64..tau,
+        0.0f64..tau,
+        -1.0f64..1.0,
+    );
+    runner(seed)
+        .run(&strategy, |(big, tube, aspect, scale, u, v, tilt)| {
+            let s = 10f64.powf(scale);
+            let (a, b) = if elliptic {
+                (tube * s, tube * aspect * s)
+            } else {
+                (tube * s, tube * s)
+            };
+            let tilt = if elliptic { tilt } else { 0.0 };
+            let big = big * s;
+            let field = FnField::new(torus_field::<f64>(big, a, b, tilt));
+            let p0 = on_torus(big, a, b, tilt, u, v);
+            let what = format!("torus R {big} a {a} b {b} tilt {tilt}");
+            let run = check(&field, p0, Shape::Closed(0), &what)?;
+            // On the torus to rounding: ((ρ − R)/a)² + (z/b)² = 1 in body coordinates.
+            let (c, sn) = (tilt.cos(), tilt.sin());
+            let worst = run
+                .mesh
+                .vertices
+                .iter()
+                .map(|w| {
+                    let (x, y, z) = (w[0], c * w[1] + sn * w[2], -sn * w[1] + c * w[2]);
+                    let rho = (x * x + y * y).sqrt();
+                    (((rho - big) / a).powi(2) + (z / b).powi(2) - 1.0).abs()
+                })
+                .fold(0.0, f64::max);
+            prop_assert!(worst <= 1e-9, "{what}: drift {worst:e}");
+            Ok(())
+        })
+        .unwrap();
+}
+
+#[test]
+#[ignore = "open: tori come out valid but not closed (the stitcher leaves holes between fronts); see docs/status.md"]
+fn tori_close_with_euler_characteristic_zero() {
+    torus_class(0x7051, false);
+}
+
+#[test]
+#[ignore = "open: tori come out valid but not closed (the stitcher leaves holes between fronts); see docs/status.md"]
+fn tilted_elliptic_tori_close_with_euler_characteristic_zero() {
+    torus_class(0x7052, true);
+}
+
+#[test]
+fn the_unit_sphere_invariant_meshes_alike_at_any_radius_and_from_an_axis() {
+    let field = diagonal([1.0, 1.0, 1.0]);
+    let mut counts = Vec::new();
+    for p0 in [
+        [0.0, 0.0, 1e-3],
+        [0.0, 0.0, 1.0],
+        [0.0, 0.0, 1e3],
+        [1.0, 0.0, 0.0],
+    ] {
+        let run = run(&field, &MeshParams::at(p0)).expect("a sphere meshes");
+        assert!(
+            run.validation.is_valid() && run.validation.is_closed(),
+            "p0 {p0:?}"
+        );
+        assert_eq!(run.validation.euler_characteristic, 2, "p0 {p0:?}");
+        assert!(
+            run.cut_short().is_empty(),
+            "p0 {p0:?}: {:?}",
+            run.cut_short()
+        );
+        counts.push(run.mesh.triangles.len() as f64);
+    }
+    let (lo, hi) = counts
+        .iter()
+        .fold((f64::MAX, 0.0f64), |(l, h), &c| (l.min(c), h.max(c)));
+    assert!(
+        hi <= 1.01 * lo,
+        "triangle counts {counts:?} differ by more than 1%"
+    );
+}
