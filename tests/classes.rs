@@ -326,11 +326,7 @@ fn non_integrable_linear_invariants_sweep_an_embedded_surface() {
             Ok(())
         })
         .unwrap();
-    assert!(
-        empty.get() * 5 <= cases,
-        "{} of {cases} fields gave no mesh (at most a fifth allowed)",
-        empty.get()
-    );
+    at_most_a_fifth_empty(empty.get(), cases, "fields");
 }
 
 #[test]
@@ -391,11 +387,7 @@ fn hamiltonian_cubics_stay_on_their_level_set() {
             Ok(())
         })
         .unwrap();
-    assert!(
-        empty.get() * 5 <= cases,
-        "{} of {cases} cubics gave no mesh (at most a fifth allowed)",
-        empty.get()
-    );
+    at_most_a_fifth_empty(empty.get(), cases, "cubics");
 }
 
 fn norm(v: Vec3<f64>) -> f64 {
@@ -538,5 +530,13 @@ fn the_unit_sphere_invariant_meshes_alike_at_any_radius_and_from_an_axis() {
     assert!(
         hi <= 1.01 * lo,
         "triangle counts {counts:?} differ by more than 1%"
+    );
+}
+
+/// Fails when more than a fifth of `cases` gave `MeshError::Empty`.
+fn at_most_a_fifth_empty(empty: u32, cases: u32, what: &str) {
+    assert!(
+        empty * 5 <= cases,
+        "{empty} of {cases} {what} gave no mesh (at most a fifth allowed)"
     );
 }

@@ -289,14 +289,7 @@ fn collinear_chart_points_give_no_sliver_triangle() {
     params.max_radius = Some(1.0);
     params.bounding_box = Some(10.0);
     params.close = true;
-    // Either a valid mesh or, where no triangle survives validation, the typed error.
-    match liemesh::run(&LieField::<f64>::new(&invariant), &params) {
-        Ok(run) => {
-            assert!(!run.mesh.triangles.is_empty());
-            fuzz_checks::check_mesh(&run.mesh).unwrap();
-        }
-        Err(e) => assert!(matches!(e, liemesh::MeshError::Empty { .. }), "{e}"),
-    }
+    valid_or_empty(liemesh::run(&LieField::<f64>::new(&invariant), &params));
 }
 
 /// Found by the `mesher` fuzz target (`fuzz/corpus/mesher/crash-straight-curves-collinear-in-
@@ -328,8 +321,12 @@ fn points_on_a_line_in_space_give_no_zero_area_triangle() {
     params.max_curves = 120;
     params.max_steps = 200;
     params.max_retries = 64;
-    // Either a valid mesh or, where no triangle survives validation, the typed error.
-    match liemesh::run(&LieField::<f64>::new(&invariant), &params) {
+    valid_or_empty(liemesh::run(&LieField::<f64>::new(&invariant), &params));
+}
+
+/// Either a valid mesh or, where no triangle survives validation, the typed error.
+fn valid_or_empty(result: Result<liemesh::MeshRun<f64>, liemesh::MeshError>) {
+    match result {
         Ok(run) => {
             assert!(!run.mesh.triangles.is_empty());
             fuzz_checks::check_mesh(&run.mesh).unwrap();
