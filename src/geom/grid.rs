@@ -147,7 +147,8 @@ fn cell_of(x: f64, inv: f64) -> i64 {
     let y = x * inv;
     let t = y as i64;
     if (t as f64) > y {
-        t - 1
+        // saturating: y below i64::MIN saturates t to i64::MIN, which is already the floor.
+        t.saturating_sub(1)
     } else {
         t
     }
