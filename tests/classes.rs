@@ -12,8 +12,8 @@
 //! | linear invariants with non-zero angles (non-integrable) | valid, at least 200 triangles; at most a fifth `MeshError::Empty` |
 //! | 18-number Hamiltonian invariants, entries in [−1, 1] | valid, at least 200 triangles |
 //! | 12-number Hamiltonian invariants with diagonal `A` (cubics) | valid, vertices on the level set; at most a fifth `MeshError::Empty` |
-//! | tori (a `FnField`) | valid, closed, χ = 0 (ignored: not met yet) |
-//! | tori with an elliptic tube about a tilted axis (a `FnField`) | valid, closed, χ = 0 (ignored: not met yet) |
+//! | tori (a `FnField`) | valid; closed with χ = 0 in at least 70% of cases |
+//! | tori with an elliptic tube about a tilted axis (a `FnField`) | valid; closed with χ = 0 in at least 70% of cases (ignored: about half close) |
 //!
 //! "Valid" is [`liemesh::mesh::Validation::is_valid`]: manifold, consistently oriented, no
 //! degenerate face and no self-intersection, decided exactly. The mesher itself refuses to
@@ -33,7 +33,7 @@ use proptest::test_runner::{Config, RngSeed, TestCaseError, TestRunner};
 
 /// Cases per class unless `PROPTEST_CASES` says otherwise: enough to meet every class's
 /// awkward members in CI time.
-const CASES: u32 = 12;
+const CASES: u32 = 24;
 
 /// The points budget of the 18-number Hamiltonian cases: their swept surfaces take from
 /// milliseconds to minutes with the default budget (see docs/status.md).
@@ -43,6 +43,11 @@ const HAMILTONIAN_POINTS: usize = 40_000;
 /// valid but with the wrong topology (an extra hole left where fronts met): measured at 0–10%
 /// over random seeds, see docs/status.md. Every mesh must still be valid.
 const BAND_MISSES: u32 = 15;
+
+/// The share of round tori (in percent) allowed to come out valid but not closed (a small
+/// hole left where fronts met, most often on thin tori): measured at 4 of 24 cases, see
+/// docs/status.md.
+const TORUS_MISSES: u32 = 30;
 
 fn runner(seed: u64) -> TestRunner {
     let mut config = Config {
@@ -118,7 +123,11 @@ fn check_with<F: NormalField<f64>>(
     // A swept (non-integrable) surface may have curves that wind on until a budget stops
     // them, and near a cone's apex a chord may find no point; the report says so. Every
     // other class must come out whole.
-    if !matches!(shape, Shape::Swept(_) | Shape::Nappe) {
+    // A torus whose stitching ran out of its budget is reported as cut short and counted as
+    // a miss below when it did not close.
+    if !matches!(shape, Shape::Swept(_) | Shape::Nappe)
+        && !(matches!(shape, Shape::Closed(0)) && run.stitched.budget_hit)
+    {
         prop_assert!(
             run.cut_short().is_empty(),
             "{context}: cut short: {:?}",
@@ -446,7 +455,11 @@ fn on_torus(big: f64, a: f64, b: f64, tilt: f64, u: f64, v: f64) -> [f64; 3] {
     [x, c * y - s * z, s * y + c * z]
 }
 
-fn torus_class(seed: u64, elliptic: bool) {
+/// The largest relative drift `|F − 1|` off a torus: the chord rule is exact for cubic
+/// potentials only, and the torus's is not one (measured: up to about 2·10⁻⁵).
+const TORUS_DRIFT: f64 = 1e-4;
+
+fn torus_class(seed: u64, elliptic: bool) -> u32 {
     let tau = std::f64::consts::TAU;
     let strategy = (
         1.5f64..4.0,
@@ -483,22 +496,24 @@ fn torus_class(seed: u64, elliptic: bool) {
                     (((rho - big) / a).powi(2) + (z / b).powi(2) - 1.0).abs()
                 })
                 .fold(0.0, f64::max);
-            prop_assert!(worst <= 1e-9, "{what}: drift {worst:e}");
+            // The drift-free chord is exact only for cubic potentials (Simpson's rule); on a
+            // torus its truncation error is of the fifth order in the step.
+            prop_assert!(worst <= TORUS_DRIFT, "{what}: drift {worst:e}");
             Ok(())
         })
         .unwrap();
+    runner(seed).config().cases
 }
 
 #[test]
-#[ignore = "open: tori come out valid but not closed (the stitcher leaves holes between fronts); see docs/status.md"]
 fn tori_close_with_euler_characteristic_zero() {
-    torus_class(0x7051, false);
+    tolerating(TORUS_MISSES, || torus_class(0x7051, false));
 }
 
 #[test]
-#[ignore = "open: tori come out valid but not closed (the stitcher leaves holes between fronts); see docs/status.md"]
+#[ignore = "open: about half of tilted elliptic tori keep a hole where fronts met; see docs/status.md"]
 fn tilted_elliptic_tori_close_with_euler_characteristic_zero() {
-    torus_class(0x7052, true);
+    tolerating(TORUS_MISSES, || torus_class(0x7052, true));
 }
 
 #[test]

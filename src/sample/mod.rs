@@ -154,6 +154,18 @@ const FENCE_THICKNESS: f64 = 0.35;
 /// merged at once.
 const COOLDOWN_STEPS: f64 = 4.0;
 
+/// An inserted curve starts halfway to its neighbour along one chord, but only when the
+/// normals of the two turn apart by at most this many times the insertion threshold (`gap` ×
+/// β_max), and they are at most [`MAX_INSERT_SPAN`] times the insertion gap apart. Farther
+/// apart, the two are neighbours only in the order of the curves (the curves between them
+/// ended, or they came round a closed surface, such as a torus, different ways): their
+/// midpoint is no place between them, and a chord that long leaves the level set on fields
+/// that are not cubic.
+const MAX_INSERT_TURN: f64 = 2.0;
+/// See [`MAX_INSERT_TURN`]: in insertion gaps (`gap` × the longer of the two curves' last
+/// steps).
+const MAX_INSERT_SPAN: f64 = 4.0;
+
 /// A step clamped at `dt_min` whose predicted turn exceeds this many `β_max` ends its curve
 /// as singular.
 const SINGULAR_TURN: f64 = 2.0;
@@ -670,6 +682,21 @@ impl<T: Scalar, F: NormalField<T>> Sampler<'_, T, F> {
         let live_c = &self.live[c as usize];
         let foot = self.foot_on(k, &live_c.p);
         let d = &foot - &live_c.p;
+        let [last_c, last_k] = [c, k].map(|i| {
+            *self.out.curves[i as usize]
+                .points
+                .last()
+                .expect("curves start with one point") as usize
+        });
+        let turn = dot(self.nrm[last_k], self.nrm[last_c])
+            .clamp(-1.0, 1.0)
+            .acos();
+        let step = self.out.steps[last_k].dt.max(len);
+        if turn > MAX_INSERT_TURN * self.params.gap * self.params.beta_max.radians()
+            || d.norm().to_f64() > MAX_INSERT_SPAN * self.params.gap * step
+        {
+            return;
+        }
         let half = d.norm() * T::from_f64(0.5);
         let start = match trace::step_fixed(self.field, &self.cfg, &live_c.p, &d, &half) {
             Ok(p) => p,

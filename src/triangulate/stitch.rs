@@ -587,7 +587,14 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
         // Nothing already there: no boundary vertex nearer than half the new edges.
         let mut crowded = false;
         self.points.near(q, 0.5 * h, |w| {
-            crowded = crowded || (w != a && w != b && dist(self.pos[w as usize], q) < 0.5 * h);
+            // Only boundary vertices: interior ones are guarded by the triangles' clearance
+            // below, and vertices an opened hole left without triangles are no longer part of
+            // the mesh (counting them kept new points out of every opened hole).
+            crowded = crowded
+                || (w != a
+                    && w != b
+                    && dist(self.pos[w as usize], q) < 0.5 * h
+                    && self.on_boundary(w));
         });
         if crowded {
             return None;
