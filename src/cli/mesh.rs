@@ -5,7 +5,7 @@ use clap::Args;
 use liemesh::io::invariant_file::InvariantFile;
 use liemesh::io::report::Report;
 use liemesh::io::{self, WriteOptions};
-use liemesh::model::{Invariant, LieField};
+use liemesh::model::{AngleReading, Invariant, LieField};
 use liemesh::preset::Preset;
 use liemesh::scalar::{Dual, Scalar, ScalarKind};
 use liemesh::{Mesh, MeshError, MeshParams};
@@ -22,6 +22,10 @@ pub struct MeshArgs {
     /// A TOML invariant file (`invariant = [...]` and an optional `[mesh]` table).
     #[arg(long, value_name = "FILE")]
     pub invariant: Option<PathBuf>,
+    /// How the invariant's angles are read (wins over the file's `angles`): `literal` is the
+    /// paper's eq. 2, A = diag(λ) R; `quadric` is A = Rᵀ diag(λ) R, a turned quadric.
+    #[arg(long, value_enum, value_name = "READING")]
+    pub angles: Option<AnglesArg>,
     /// Output mesh: .ply (binary unless --ascii), .obj or .stl.
     #[arg(short, long, value_name = "FILE")]
     pub output: Option<PathBuf>,
@@ -49,6 +53,24 @@ pub struct MeshArgs {
     /// Parameter overrides (they win over the preset and the file).
     #[command(flatten)]
     pub overrides: Overrides,
+}
+
+/// `--angles` values (the library's [`AngleReading`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum AnglesArg {
+    /// A = diag(λ) Rx(θ) Ry(φ) Rz(ψ), the paper's eq. 2.
+    Literal,
+    /// A = Rᵀ diag(λ) R: the quadric with axes scaled by λ, turned.
+    Quadric,
+}
+
+impl From<AnglesArg> for AngleReading {
+    fn from(a: AnglesArg) -> AngleReading {
+        match a {
+            AnglesArg::Literal => AngleReading::Literal,
+            AnglesArg::Quadric => AngleReading::Quadric,
+        }
+    }
 }
 
 /// `--scalar` values.
@@ -219,6 +241,7 @@ impl MeshArgs {
         MeshArgs {
             preset: Some(Preset::Fig6),
             invariant: None,
+            angles: None,
             output: Some(PathBuf::from("out/fig6.ply")),
             ascii: false,
             report: Some(PathBuf::from("out/fig6.json")),
@@ -256,6 +279,10 @@ impl MeshArgs {
             }
         };
         params = self.overrides.apply(params)?;
+        let invariant = match self.angles {
+            Some(a) => invariant.with_reading(a.into()),
+            None => invariant,
+        };
         Ok((preset, invariant, params))
     }
 }

@@ -3,9 +3,9 @@
 use super::CliError;
 use clap::Args;
 use liemesh::io::invariant_file::InvariantFile;
-use liemesh::model::{Invariant, LieField};
+use liemesh::model::{AngleReading, Invariant, LieField};
 use liemesh::preset::Preset;
-use liemesh::quality::{recover, QualityReport};
+use liemesh::quality::{decompose_in, recover, QualityReport};
 use liemesh::Mode;
 use serde::Serialize;
 use std::path::PathBuf;
@@ -115,6 +115,9 @@ pub struct RecoverArgs {
     /// Compare with the invariant in this file.
     #[arg(long)]
     pub invariant: Option<PathBuf>,
+    /// Read the recovered angles this way (default: the reference's reading, else literal).
+    #[arg(long, value_enum, value_name = "READING")]
+    pub angles: Option<super::mesh::AnglesArg>,
     /// Print JSON.
     #[arg(long)]
     pub json: bool,
@@ -127,7 +130,13 @@ pub(super) fn recover_cmd(args: &RecoverArgs) -> Result<ExitCode, CliError> {
         (None, Some(f)) => Some(InvariantFile::read(f)?.invariant),
         (None, None) => None,
     };
-    let r = recover(&mesh, args.hamiltonian, reference.as_ref());
+    let mut r = recover(&mesh, args.hamiltonian, reference.as_ref());
+    if let Some(reading) = args.angles.map(AngleReading::from) {
+        if reading != r.reading {
+            r.reading = reading;
+            r.a_invariant = decompose_in(&r.a, reading, None);
+        }
+    }
     if args.json {
         println!(
             "{}",
@@ -137,7 +146,8 @@ pub(super) fn recover_cmd(args: &RecoverArgs) -> Result<ExitCode, CliError> {
     }
     let inv = r.a_invariant;
     println!(
-        "recovered A invariant (λ1 λ2 λ3 θ φ ψ): {:.6} {:.6} {:.6} {:.6} {:.6} {:.6}",
+        "recovered A invariant (λ1 λ2 λ3 θ φ ψ, angles in radians, {} reading): {:.6} {:.6} {:.6} {:.6} {:.6} {:.6}",
+        r.reading.name(),
         inv[0], inv[1], inv[2], inv[3], inv[4], inv[5]
     );
     for (name, m) in [("A", r.a), ("B", r.b)] {

@@ -1,8 +1,11 @@
 //! Invariant files: an invariant and, optionally, any mesher parameter, in TOML.
 //!
 //! ```toml
-//! # 6 numbers (linear), 12 (the paper's text order) or 18 (Table 2's three rows).
+//! # 6 numbers (linear), 12 (the paper's text order) or 18 (Table 2's three rows);
+//! # each row is λ1 λ2 λ3 θ φ ψ, angles in radians.
 //! invariant = [1.0, 4.0, 16.0, 0.0, 0.0, 0.0]
+//! angles = "literal"    # optional: "literal" (A = diag(λ) R, the paper's eq. 2, the
+//!                       # default) or "quadric" (A = Rᵀ diag(λ) R, a turned quadric)
 //!
 //! [mesh]            # every key is optional; missing ones keep their defaults
 //! method = "proposed"   # or "previous" (then `curves` sets their number)
@@ -16,7 +19,7 @@
 //! The `[mesh]` keys are [`MeshParams`]'s fields, angles in degrees (`*_deg`). Unknown keys
 //! and values of the wrong type are errors that name the key.
 
-use crate::model::{Invariant, InvariantError};
+use crate::model::{AngleReading, Invariant, InvariantError};
 use crate::params::MeshParams;
 use serde::Deserialize;
 use std::path::{Path, PathBuf};
@@ -56,6 +59,8 @@ pub enum InvariantFileError {
 struct FileContents {
     invariant: Vec<f64>,
     #[serde(default)]
+    angles: AngleReading,
+    #[serde(default)]
     mesh: MeshParams,
 }
 
@@ -86,12 +91,12 @@ impl InvariantFile {
                 path: path.to_path_buf(),
                 message: one_line(&e),
             })?;
-        let invariant = Invariant::from_numbers(&contents.invariant).map_err(|source| {
-            InvariantFileError::Invariant {
+        let invariant = Invariant::from_numbers(&contents.invariant)
+            .map_err(|source| InvariantFileError::Invariant {
                 path: path.to_path_buf(),
                 source,
-            }
-        })?;
+            })?
+            .with_reading(contents.angles);
         Ok(InvariantFile {
             invariant,
             params: contents.mesh,
@@ -137,6 +142,21 @@ mod tests {
         let e = parse("invariant = [1, 1, 1, 0, 0, 0]\n[mesh]\nmethod = \"fast\"").unwrap_err();
         let msg = e.to_string();
         assert!(msg.contains("fast") && msg.contains("`proposed`"), "{msg}");
+    }
+
+    #[test]
+    fn the_angles_are_read_literally_unless_the_file_says_quadric() {
+        let f = parse("invariant = [1, 2, 3, 0.1, 0.2, 0.3]").unwrap();
+        assert_eq!(f.invariant.reading(), AngleReading::Literal);
+        let f = parse("invariant = [1, 2, 3, 0.1, 0.2, 0.3]\nangles = \"quadric\"").unwrap();
+        assert_eq!(f.invariant.reading(), AngleReading::Quadric);
+        let msg = parse("invariant = [1, 1, 1, 0, 0, 0]\nangles = \"degrees\"")
+            .unwrap_err()
+            .to_string();
+        assert!(
+            msg.contains("degrees") && msg.contains("`quadric`"),
+            "{msg}"
+        );
     }
 
     #[test]

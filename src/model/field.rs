@@ -1,6 +1,6 @@
 //! Normal fields: what the mesher consumes.
 
-use super::invariant::{Invariant, Lift, Mat3};
+use super::invariant::{AngleReading, Invariant, Lift, Mat3};
 use crate::scalar::{Dual, Scalar, Vec3};
 
 /// A normal field `v: R³ → R³` evaluated in the scalar type `T`.
@@ -87,7 +87,7 @@ pub struct LieField<T> {
 impl<T: Scalar> LieField<T> {
     /// The field of `invariant`, with matrices computed in `T`.
     pub fn new(invariant: &Invariant) -> Self {
-        Self::from_parameters(&invariant.parameters::<T>())
+        Self::from_parameters(&invariant.parameters::<T>(), invariant.reading())
     }
 
     /// The field whose invariant number `index` (in the 18-number layout: row-major over
@@ -106,20 +106,21 @@ impl<T: Scalar> LieField<T> {
                 }
             })
             .collect();
-        LieField::from_parameters(&params)
+        LieField::from_parameters(&params, invariant.reading())
     }
 
-    /// The field from the 18 numbers of the Table 2 layout, already in `T`.
-    pub fn from_parameters(params: &[T]) -> Self {
-        let a = Invariant::row_matrix(&params[0..6]);
-        let b = Invariant::row_matrix(&params[6..12]);
-        let c = Invariant::row_matrix(&params[12..18]);
+    /// The field from the 18 numbers of the Table 2 layout, already in `T`, with the angles
+    /// read as `reading` says.
+    pub fn from_parameters(params: &[T], reading: AngleReading) -> Self {
+        let a = reading.matrix(&params[0..6]);
+        let b = reading.matrix(&params[6..12]);
+        let c = reading.matrix(&params[12..18]);
         let quadratic = b
             .iter()
             .any(|r| !(r.x.is_zero() && r.y.is_zero() && r.z.is_zero()));
         let in_f64 = (T::unit_roundoff() < f64::unit_roundoff()).then(|| {
             let rounded: Vec<f64> = params.iter().map(Scalar::to_f64).collect();
-            Box::new(LieField::from_parameters(&rounded))
+            Box::new(LieField::from_parameters(&rounded, reading))
         });
         LieField {
             a,

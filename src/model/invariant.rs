@@ -85,11 +85,83 @@ impl Lift {
     }
 }
 
+/// How the three angles of an invariant row turn its matrix (DESIGN.md §1). Angles are in
+/// radians; `R = Rx(θ) Ry(φ) Rz(ψ)`, each a right-handed rotation about a coordinate axis.
+///
+/// ```
+/// use liemesh::model::{AngleReading, Invariant};
+/// // The unit sphere turned by any angles is still the unit sphere in the quadric reading...
+/// let turned = Invariant::from_numbers(&[1.0, 1.0, 1.0, 0.3, 0.5, 0.7])?
+///     .with_reading(AngleReading::Quadric);
+/// let a = turned.a_matrix::<f64>();
+/// assert!((a[0].x - 1.0).abs() < 1e-15 && a[0].y.abs() < 1e-15);
+/// // ...but not in the paper's literal reading, where A = R is not symmetric.
+/// let literal = Invariant::from_numbers(&[1.0, 1.0, 1.0, 0.3, 0.5, 0.7])?;
+/// assert!((literal.a_matrix::<f64>()[0].y - literal.a_matrix::<f64>()[1].x).abs() > 0.1);
+/// # Ok::<(), liemesh::model::InvariantError>(())
+/// ```
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(rename_all = "lowercase"))]
+pub enum AngleReading {
+    /// The paper's eq. 2 read literally: `A = diag(λ) R`. Not symmetric once an angle is
+    /// non-zero, so the field is then not a gradient and the surface is a swept one.
+    #[default]
+    Literal,
+    /// A posed quadric: `A = Rᵀ diag(λ) R`, the quadric with axes scaled by `λ`, turned by
+    /// `Rᵀ` (its principal axes are the rows of `R`). Symmetric, so the field is the gradient of
+    /// `½ pᵀ A p` (plus the cubic terms of a diagonal `B`).
+    Quadric,
+}
+
+impl AngleReading {
+    /// The row's matrix, `(λ1, λ2, λ3, θ, φ, ψ)` read this way, in any scalar type.
+    pub fn matrix<T: Scalar>(self, row: &[T]) -> Mat3<T> {
+        match self {
+            AngleReading::Literal => Invariant::row_matrix(row),
+            AngleReading::Quadric => {
+                let r = Invariant::row_matrix(&[
+                    T::one(),
+                    T::one(),
+                    T::one(),
+                    row[3].clone(),
+                    row[4].clone(),
+                    row[5].clone(),
+                ]);
+                // (Rᵀ Λ R)_ij = Σ_k R_ki λ_k R_kj, computed once per pair so that the matrix
+                // is exactly symmetric (the field then is exactly a gradient).
+                let entry = |i: usize, j: usize| {
+                    let mut s = T::zero();
+                    for (k, rk) in r.iter().enumerate() {
+                        s.add_product(&rk[i].product(&row[k]), &rk[j]);
+                    }
+                    s
+                };
+                let (xy, xz, yz) = (entry(0, 1), entry(0, 2), entry(1, 2));
+                [
+                    Vec3::new(entry(0, 0), xy.clone(), xz.clone()),
+                    Vec3::new(xy, entry(1, 1), yz.clone()),
+                    Vec3::new(xz, yz, entry(2, 2)),
+                ]
+            }
+        }
+    }
+
+    /// The name used in invariant files and on the command line.
+    pub fn name(self) -> &'static str {
+        match self {
+            AngleReading::Literal => "literal",
+            AngleReading::Quadric => "quadric",
+        }
+    }
+}
+
 /// The numbers that define a surface.
 ///
-/// Stored in the 18-number form: row `k` is `(λ1k, λ2k, λ3k, θk, φk, ψk)` and builds
-/// `diag(λ·k) · Rx(θk) Ry(φk) Rz(ψk)`; row 1 is `A`, row 2 is `B`, row 3 is `C`.
-/// A linear invariant has rows 2 and 3 zero.
+/// Stored in the 18-number form: row `k` is `(λ1k, λ2k, λ3k, θk, φk, ψk)`, angles in radians;
+/// row 1 is `A`, row 2 is `B`, row 3 is `C`. A linear invariant has rows 2 and 3 zero. Each
+/// row builds its matrix as its [`AngleReading`] says: `diag(λ) Rx(θ) Ry(φ) Rz(ψ)` (the
+/// paper's eq. 2, the default) or `Rᵀ diag(λ) R` (a posed quadric).
 ///
 /// ```
 /// use liemesh::model::Invariant;
@@ -105,6 +177,8 @@ impl Lift {
 pub struct Invariant {
     kind: InvariantKind,
     rows: [[f64; 6]; 3],
+    #[cfg_attr(feature = "serde", serde(default))]
+    reading: AngleReading,
 }
 
 impl Invariant {
@@ -140,7 +214,22 @@ impl Invariant {
             }
             n => return Err(InvariantError::WrongCount(n)),
         };
-        Ok(Invariant { kind, rows })
+        Ok(Invariant {
+            kind,
+            rows,
+            reading: AngleReading::default(),
+        })
+    }
+
+    /// The same numbers with the angles read as `reading` says.
+    pub fn with_reading(mut self, reading: AngleReading) -> Self {
+        self.reading = reading;
+        self
+    }
+
+    /// How the angles are read.
+    pub fn reading(&self) -> AngleReading {
+        self.reading
     }
 
     /// Linear or Hamiltonian.
@@ -161,7 +250,8 @@ impl Invariant {
         }
     }
 
-    /// `diag(λ) · Rx(θ) · Ry(φ) · Rz(ψ)` from one row, in any scalar type.
+    /// `diag(λ) · Rx(θ) · Ry(φ) · Rz(ψ)` from one row, in any scalar type (the literal
+    /// reading; [`AngleReading::matrix`] reads a row either way).
     pub fn row_matrix<T: Scalar>(row: &[T]) -> Mat3<T> {
         let (s1, c1) = (row[3].sin(), row[3].cos());
         let (s2, c2) = (row[4].sin(), row[4].cos());
@@ -200,17 +290,17 @@ impl Invariant {
             .collect()
     }
 
-    /// `A` (paper eq. 2).
+    /// `A` (paper eq. 2, or the posed quadric's matrix in [`AngleReading::Quadric`]).
     pub fn a_matrix<T: Scalar>(&self) -> Mat3<T> {
-        Self::row_matrix(&self.parameters::<T>()[0..6])
+        self.reading.matrix(&self.parameters::<T>()[0..6])
     }
     /// `B` (row 2 of Table 2; diagonal in the 12-number form).
     pub fn b_matrix<T: Scalar>(&self) -> Mat3<T> {
-        Self::row_matrix(&self.parameters::<T>()[6..12])
+        self.reading.matrix(&self.parameters::<T>()[6..12])
     }
     /// `C` (row 3 of Table 2; diagonal in the 12-number form).
     pub fn c_matrix<T: Scalar>(&self) -> Mat3<T> {
-        Self::row_matrix(&self.parameters::<T>()[12..18])
+        self.reading.matrix(&self.parameters::<T>()[12..18])
     }
 
     /// `H = [[A, B], [C, −Aᵀ]]` (paper eq. 4) in `f64`, row-major.

@@ -11,5 +11,5 @@ mod invariant;
 mod shape;
 
 pub use field::{jacobian, FnField, LieField, NormalField};
-pub use invariant::{Invariant, InvariantError, InvariantKind, Lift, Mat3};
+pub use invariant::{AngleReading, Invariant, InvariantError, InvariantKind, Lift, Mat3};
 pub use shape::{least_aligned_tangent, LocalShape, INTEGRABLE_DEFECT};

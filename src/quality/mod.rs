@@ -13,7 +13,7 @@ pub use fidelity::{
     diagonal, drift, face_error_deg, face_normal_error, integrability_defect, step_quality, Drift,
     StepQuality,
 };
-pub use recover::{decompose, jet_normals, mesh_normals, recover, Recovery};
+pub use recover::{decompose, decompose_in, jet_normals, mesh_normals, recover, Recovery};
 pub use shape::Shape;
 pub use topology::Topology;
 

@@ -5,10 +5,11 @@
 //! fitted to the two-ring gives the normal to third order ([`jet_normals`]). Since `n ∥ A p + B (p∘p)`, each vertex gives three equations
 //! `n × (A p + B (p∘p)) = 0` that are linear in the entries of `A` (and `B`); the least-squares
 //! solution of unit norm is the right singular vector of the smallest singular value. It is
-//! scaled to the reference by least squares and decomposed as `A = diag(λ) Rx(θ) Ry(φ) Rz(ψ)`.
+//! scaled to the reference by least squares and decomposed in either reading of the angles
+//! ([`AngleReading`]): `A = diag(λ) Rx(θ) Ry(φ) Rz(ψ)` or `A = Rᵀ diag(λ) R`.
 
 use crate::geom::vec3::{cross, dot, normalize, sub};
-use crate::model::Invariant;
+use crate::model::{AngleReading, Invariant};
 use crate::triangulate::Mesh;
 use nalgebra::{DMatrix, Matrix3};
 
@@ -21,8 +22,12 @@ pub struct Recovery {
     pub a: [[f64; 3]; 3],
     /// Recovered `B` (zero for the linear model).
     pub b: [[f64; 3]; 3],
-    /// `(λ1, λ2, λ3, θ, φ, ψ)` of the recovered `A`.
+    /// `(λ1, λ2, λ3, θ, φ, ψ)` of the recovered `A`, angles in radians, in the reading
+    /// [`Recovery::reading`] (see [`decompose_in`]).
     pub a_invariant: [f64; 6],
+    /// How [`Recovery::a_invariant`]'s angles are read: the reference's reading when a
+    /// reference was given, else the literal one.
+    pub reading: AngleReading,
     /// RMS of the equations' residual at unit norm (0 when some field fits every vertex
     /// normal exactly).
     pub residual: f64,
@@ -168,7 +173,9 @@ pub fn jet_normals(mesh: &Mesh) -> Vec<[f64; 3]> {
 }
 
 /// Fits the field to `mesh`; `hamiltonian` adds the 9 entries of `B`. With a `reference`
-/// invariant, the fit is scaled to it and its relative error reported.
+/// invariant, the fit is scaled to it, its relative error reported, and `A` decomposed in the
+/// reference's reading of the angles, as close to the reference's numbers as the
+/// decomposition's symmetries allow.
 pub fn recover(mesh: &Mesh, hamiltonian: bool, reference: Option<&Invariant>) -> Recovery {
     let normals = jet_normals(mesh);
     let unknowns = if hamiltonian { 18 } else { 9 };
@@ -303,8 +310,15 @@ pub fn recover(mesh: &Mesh, hamiltonian: bool, reference: Option<&Invariant>) ->
             b[r][c] *= k;
         }
     }
+    let reading = reference.map_or(AngleReading::Literal, Invariant::reading);
+    let near = reference.map(|inv| {
+        let mut row = [0.0; 6];
+        row.copy_from_slice(&inv.rows()[0]);
+        row
+    });
     Recovery {
-        a_invariant: decompose(&a),
+        a_invariant: decompose_in(&a, reading, near.as_ref()),
+        reading,
         a,
         b,
         residual,
@@ -340,9 +354,99 @@ pub fn decompose(a: &[[f64; 3]; 3]) -> [f64; 6] {
     [lambda[0], lambda[1], lambda[2], theta, phi, psi]
 }
 
+/// `A` → `(λ1, λ2, λ3, θ, φ, ψ)` in either reading of the angles (radians).
+///
+/// A matrix has several decompositions: in the literal reading, signs of `λ` trade with the
+/// rows of `R` ([`decompose`] chooses); in the quadric reading, any order of the eigenvalues
+/// and any signs of the eigenvectors give the same `A = Rᵀ diag(λ) R` (its symmetric part is
+/// used). With `near` (e.g. the invariant the mesh was made from), the decomposition closest to
+/// it is returned (λ by absolute difference, angles modulo 2π); without, the one whose angles
+/// are smallest.
+pub fn decompose_in(a: &[[f64; 3]; 3], reading: AngleReading, near: Option<&[f64; 6]>) -> [f64; 6] {
+    match reading {
+        AngleReading::Literal => decompose(a),
+        AngleReading::Quadric => decompose_quadric(a, near),
+    }
+}
+
+fn decompose_quadric(a: &[[f64; 3]; 3], near: Option<&[f64; 6]>) -> [f64; 6] {
+    let sym = Matrix3::from_fn(|i, j| 0.5 * (a[i][j] + a[j][i]));
+    let eig = sym.symmetric_eigen();
+    let wrap = |x: f64| {
+        let t = std::f64::consts::TAU;
+        x - t * (x / t).round()
+    };
+    let cost = |c: &[f64; 6]| match near {
+        Some(n) => (0..3)
+            .map(|i| (c[i] - n[i]).powi(2) + wrap(c[i + 3] - n[i + 3]).powi(2))
+            .sum::<f64>(),
+        None => c[3..].iter().map(|x| x.abs()).sum(),
+    };
+    const ORDERS: [[usize; 3]; 6] = [
+        [0, 1, 2],
+        [0, 2, 1],
+        [1, 0, 2],
+        [1, 2, 0],
+        [2, 0, 1],
+        [2, 1, 0],
+    ];
+    let mut best: Option<([f64; 6], f64)> = None;
+    for order in ORDERS {
+        for signs in 0..8u32 {
+            // Rows of R are the eigenvectors (the columns of `eig.eigenvectors`).
+            let mut r = Matrix3::<f64>::zeros();
+            for (row, &k) in order.iter().enumerate() {
+                let sign = if signs >> row & 1 == 1 { -1.0 } else { 1.0 };
+                for j in 0..3 {
+                    r[(row, j)] = sign * eig.eigenvectors[(j, k)];
+                }
+            }
+            if r.determinant() < 0.0 {
+                continue;
+            }
+            let phi = r[(0, 2)].clamp(-1.0, 1.0).asin();
+            let psi = (-r[(0, 1)]).atan2(r[(0, 0)]);
+            let theta = (-r[(1, 2)]).atan2(r[(2, 2)]);
+            let lambda = order.map(|k| eig.eigenvalues[k]);
+            let c = [lambda[0], lambda[1], lambda[2], theta, phi, psi];
+            let k = cost(&c);
+            if best.as_ref().is_none_or(|(_, b)| k < *b) {
+                best = Some((c, k));
+            }
+        }
+    }
+    best.expect("half of the sign choices have determinant +1")
+        .0
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_quadric_reading_decomposes_back_to_its_numbers() {
+        let numbers = [0.5, 2.0, 3.0, 0.3, -0.4, 1.1];
+        let inv = Invariant::from_numbers(&numbers)
+            .unwrap()
+            .with_reading(AngleReading::Quadric);
+        let a = inv.a_matrix::<f64>().map(|r| r.to_f64());
+        let d = decompose_in(&a, AngleReading::Quadric, Some(&numbers));
+        for (x, y) in d.iter().zip(numbers) {
+            assert!((x - y).abs() < 1e-12, "{d:?}");
+        }
+        // Without a hint: the same matrix, whichever decomposition is chosen.
+        let d = decompose_in(&a, AngleReading::Quadric, None);
+        let back = Invariant::from_numbers(&d)
+            .unwrap()
+            .with_reading(AngleReading::Quadric)
+            .a_matrix::<f64>()
+            .map(|r| r.to_f64());
+        for i in 0..3 {
+            for j in 0..3 {
+                assert!((back[i][j] - a[i][j]).abs() < 1e-12, "{back:?} {a:?}");
+            }
+        }
+    }
 
     #[test]
     fn decompose_inverts_the_invariant_matrix() {
