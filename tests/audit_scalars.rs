@@ -72,7 +72,7 @@ fn decision_comparison_reports_where_runs_part_and_why() {
         "{first}"
     );
     assert!(a.decisions_note().contains(&first));
-    let rows = scalars::agreement_rows(preset, &a, scalars::F64_BOUND, false);
+    let rows = scalars::agreement_rows(preset.name(), &a, scalars::F64_BOUND, false);
     assert!(!rows[0].pass, "the decision row must fail: {:?}", rows[0]);
     assert!(rows[1].note.contains("common prefix"), "{}", rows[1].note);
 }

@@ -156,3 +156,38 @@ fn json_prints_the_report_with_its_quality_section() {
         assert!(q.get(key).is_some(), "quality lacks {key}");
     }
 }
+
+#[test]
+fn audit_and_quality_take_invariant_files() {
+    let file = "examples/surfaces/cubic.toml";
+    let out = liemesh()
+        .args(["audit", "--invariant", file])
+        .output()
+        .unwrap();
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(out.status.success(), "{text}");
+    assert!(
+        text.contains("mesh valid") && text.contains("cubic"),
+        "{text}"
+    );
+    assert!(
+        text.contains("prediction order") && text.contains(" 0 failed"),
+        "{text}"
+    );
+
+    let out = liemesh()
+        .args(["quality", "--invariant", file])
+        .output()
+        .unwrap();
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(out.status.success(), "{text}");
+    assert!(text.contains("| cubic | default | 6120 |"), "{text}");
+
+    // A file that is not there: a clear error, exit 2 as for any bad input.
+    let out = liemesh()
+        .args(["audit", "--invariant", "no/such/file.toml"])
+        .output()
+        .unwrap();
+    assert!(!out.status.success());
+    assert!(String::from_utf8_lossy(&out.stderr).contains("no/such/file.toml"));
+}

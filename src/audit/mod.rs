@@ -11,6 +11,7 @@
 //! | [`prediction`] | the first-order prediction `v + Δt J w` of the normal at `p + Δt w` is off by `O(Δt²)` (log-log slope 2); exact for a linear field | the exact `v(p + Δt w)` in the same precision |
 //! | [`jvp`] | the dual-number JVP `J_v(p) w` | closed form in double-double; `Dual<Mpfr<256>>`; an `Mpfr<512>` central difference |
 //! | [`scalars`] | the whole mesh in `f32`, `f64`, `Dual<f64>`, `Mpfr<64>` | the same mesh in `Mpfr<256>` (or `f64` without MPFR) |
+//! | [`field`] | all of the above, and validity, for any field built in every scalar type (an invariant file, a formula of one's own) | as above, probed on the field's own mesh |
 //!
 //! The MPFR references need the `mpfr` cargo feature; without it the `f64`/dual rows still
 //! run (their references are then `f64` and double-double), and [`MPFR_AVAILABLE`] says so.
@@ -23,6 +24,7 @@
 //! assert!(rows.iter().all(|r| r.pass), "{rows:#?}");
 //! ```
 
+pub mod field;
 pub mod jvp;
 pub mod prediction;
 mod rng;
@@ -31,6 +33,7 @@ pub mod scalars;
 use crate::model::Invariant;
 use crate::preset::Preset;
 
+pub use field::audit_field;
 pub use rng::XorShift64;
 
 /// Whether this build has the `mpfr` feature, i.e. whether the MPFR rows are produced.

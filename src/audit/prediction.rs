@@ -80,6 +80,15 @@ pub fn prediction_angles<T: Scalar, F: NormalField<T>>(
     field: &F,
     probe: &Probe,
 ) -> Option<Vec<(f64, f64)>> {
+    prediction_angles_at(field, probe, 1.0)
+}
+
+/// [`prediction_angles`] with the steps `Δt = length · 2^-k`, for a surface of size `length`.
+pub fn prediction_angles_at<T: Scalar, F: NormalField<T>>(
+    field: &F,
+    probe: &Probe,
+    length: f64,
+) -> Option<Vec<(f64, f64)>> {
     let p = Vec3::<T>::from_f64(probe.point);
     let (_, n, _) = trace::unit_normal(field, &p).ok()?;
     let w = trace::project_tangent(&Vec3::from_f64(probe.direction), &n)?;
@@ -87,7 +96,7 @@ pub fn prediction_angles<T: Scalar, F: NormalField<T>>(
     Some(
         DT_EXPONENTS
             .map(|k| {
-                let dt = T::from_f64((-k as f64).exp2());
+                let dt = T::from_f64(length * (-k as f64).exp2());
                 let predicted = v.add_scaled(&dt, &jw);
                 let exact = field.normal(&p.add_scaled(&dt, &w));
                 (-k as f64, predicted.angle_to(&exact).to_f64())

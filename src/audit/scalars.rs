@@ -1,5 +1,6 @@
-//! Scalar agreement (DESIGN.md §4): the whole mesh of a preset computed in `f32`, `f64`,
-//! `Dual<f64>` (its real part) and `Mpfr<64>`, against the same mesh in `Mpfr<256>`.
+//! Scalar agreement (DESIGN.md §4): the whole mesh of a preset, or of any field that can be
+//! built in every scalar type ([`EveryScalar`]), computed in `f32`, `f64`, `Dual<f64>` (its
+//! real part) and `Mpfr<64>`, against the same mesh in `Mpfr<256>`.
 //!
 //! Two figures per scalar type and preset:
 //!
@@ -28,10 +29,11 @@
 //! use `f64` as their reference.
 
 use super::Row;
-use crate::model::LieField;
+use crate::model::{EveryScalar, LieField};
 use crate::preset::Preset;
 use crate::sample::Samples;
 use crate::scalar::{Dual, Scalar};
+use crate::MeshParams;
 use crate::{MeshError, MeshRun};
 use std::collections::{HashMap, HashSet};
 
@@ -438,15 +440,24 @@ pub fn run_preset<T: Scalar>(preset: Preset) -> Result<MeshRun<T>, MeshError> {
     crate::run(&LieField::<T>::new(&preset.invariant()), &preset.params())
 }
 
-/// The decision and vertex rows of one comparison. `informative` makes the decision row pass
-/// whatever it finds (the `f32` choice documented in the module).
+/// Runs the whole pipeline of `field` built in `T`.
+pub fn run_in<T: Scalar, S: EveryScalar>(
+    field: &S,
+    params: &MeshParams,
+) -> Result<MeshRun<T>, MeshError> {
+    crate::run(&field.in_scalar::<T>(), params)
+}
+
+/// The decision and vertex rows of one comparison, labelled `label` (a preset's name or the
+/// audited field's). `informative` makes the decision row pass whatever it finds (the `f32`
+/// choice documented in the module).
 pub fn agreement_rows(
-    preset: Preset,
+    label: &str,
     agreement: &Agreement,
     bound: f64,
     informative: bool,
 ) -> Vec<Row> {
-    let name = Some(preset.name());
+    let name = Some(label);
     let mut decisions = Row::at_most(
         format!("decisions vs {} [differences]", agreement.reference),
         agreement.scalar.clone(),
@@ -475,18 +486,18 @@ pub fn agreement_rows(
 
 /// Compares a run (or its error) with a reference into rows; a failed run gives failed rows.
 fn rows_for<T: Widen<R>, R: Scalar>(
-    preset: Preset,
+    label: &str,
     run: &Result<MeshRun<T>, MeshError>,
     reference: &MeshRun<R>,
     bound: f64,
     informative: bool,
 ) -> Vec<Row> {
     match run {
-        Ok(run) => agreement_rows(preset, &compare(run, reference), bound, informative),
+        Ok(run) => agreement_rows(label, &compare(run, reference), bound, informative),
         Err(e) => vec![Row::failed(
             format!("mesh vs {}", R::type_name()),
             T::type_name(),
-            Some(preset.name()),
+            Some(label),
             bound,
             format!("the {} run failed: {e}", T::type_name()),
         )],
@@ -496,7 +507,7 @@ fn rows_for<T: Widen<R>, R: Scalar>(
 /// The `Dual<f64>` real part against `f64`: measured as decision differences plus points
 /// whose coordinates are not bit-identical, bound 0.
 pub fn dual_matches_f64(
-    preset: Preset,
+    label: &str,
     dual: &Result<MeshRun<Dual<f64>>, MeshError>,
     f64_run: &Result<MeshRun<f64>, MeshError>,
 ) -> Row {
@@ -507,7 +518,7 @@ pub fn dual_matches_f64(
             Row::at_most(
                 check,
                 "Dual<f64>",
-                Some(preset.name()),
+                Some(label),
                 (a.decision_differences + a.differing_points) as f64,
                 0.0,
                 format!(
@@ -522,37 +533,46 @@ pub fn dual_matches_f64(
         (Err(e), _) | (_, Err(e)) => Row::failed(
             check,
             "Dual<f64>",
-            Some(preset.name()),
+            Some(label),
             0.0,
             format!("a run failed: {e}"),
         ),
     }
 }
 
-/// Every scalar-agreement row of `preset`: decisions and vertex error of `f32`, `f64`,
-/// `Dual<f64>` and `Mpfr<64>` against `Mpfr<256>` (with the `mpfr` feature; without it, of
-/// `f32` against `f64`), and the `Dual<f64>` ≡ `f64` row.
+/// Every scalar-agreement row of `preset`: see [`scalar_agreement_of`].
 pub fn scalar_agreement(preset: Preset) -> Vec<Row> {
-    let f32_run = run_preset::<f32>(preset);
-    let f64_run = run_preset::<f64>(preset);
-    let dual_run = run_preset::<Dual<f64>>(preset);
+    scalar_agreement_of(&preset.invariant(), &preset.params(), preset.name())
+}
+
+/// Every scalar-agreement row of `field` meshed with `params`, labelled `label`: decisions
+/// and vertex error of `f32`, `f64`, `Dual<f64>` and `Mpfr<64>` against `Mpfr<256>` (with the
+/// `mpfr` feature; without it, of `f32` against `f64`), and the `Dual<f64>` ≡ `f64` row.
+pub fn scalar_agreement_of<S: EveryScalar>(
+    field: &S,
+    params: &MeshParams,
+    label: &str,
+) -> Vec<Row> {
+    let f32_run = run_in::<f32, S>(field, params);
+    let f64_run = run_in::<f64, S>(field, params);
+    let dual_run = run_in::<Dual<f64>, S>(field, params);
     let mut rows = Vec::new();
 
     #[cfg(feature = "mpfr")]
     {
         use crate::scalar::Mpfr;
-        match run_preset::<Mpfr<256>>(preset) {
+        match run_in::<Mpfr<256>, S>(field, params) {
             Ok(reference) => {
-                rows.extend(rows_for(preset, &f32_run, &reference, F32_BOUND, true));
-                rows.extend(rows_for(preset, &f64_run, &reference, F64_BOUND, false));
-                rows.extend(rows_for(preset, &dual_run, &reference, DUAL_BOUND, false));
-                let mpfr64 = run_preset::<Mpfr<64>>(preset);
-                rows.extend(rows_for(preset, &mpfr64, &reference, MPFR64_BOUND, false));
+                rows.extend(rows_for(label, &f32_run, &reference, F32_BOUND, true));
+                rows.extend(rows_for(label, &f64_run, &reference, F64_BOUND, false));
+                rows.extend(rows_for(label, &dual_run, &reference, DUAL_BOUND, false));
+                let mpfr64 = run_in::<Mpfr<64>, S>(field, params);
+                rows.extend(rows_for(label, &mpfr64, &reference, MPFR64_BOUND, false));
             }
             Err(e) => rows.push(Row::failed(
                 "mesh vs Mpfr<256>",
                 "Mpfr<256>",
-                Some(preset.name()),
+                Some(label),
                 0.0,
                 format!("the reference run failed: {e}"),
             )),
@@ -561,17 +581,17 @@ pub fn scalar_agreement(preset: Preset) -> Vec<Row> {
     #[cfg(not(feature = "mpfr"))]
     {
         match &f64_run {
-            Ok(reference) => rows.extend(rows_for(preset, &f32_run, reference, F32_BOUND, true)),
+            Ok(reference) => rows.extend(rows_for(label, &f32_run, reference, F32_BOUND, true)),
             Err(e) => rows.push(Row::failed(
                 "mesh vs f64",
                 "f64",
-                Some(preset.name()),
+                Some(label),
                 0.0,
                 format!("the reference run failed: {e}"),
             )),
         }
     }
 
-    rows.push(dual_matches_f64(preset, &dual_run, &f64_run));
+    rows.push(dual_matches_f64(label, &dual_run, &f64_run));
     rows
 }

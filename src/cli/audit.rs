@@ -5,8 +5,10 @@
 use super::CliError;
 use clap::Args;
 use liemesh::audit::{self, Row};
+use liemesh::io::invariant_file::InvariantFile;
 use liemesh::preset::Preset;
 use std::io::Write;
+use std::path::PathBuf;
 use std::process::ExitCode;
 
 /// Arguments of `liemesh audit`.
@@ -15,6 +17,10 @@ pub struct AuditArgs {
     /// Audit this preset; repeat the flag for several. All six when omitted.
     #[arg(long, value_parser = super::preset_parser())]
     pub preset: Vec<Preset>,
+    /// Audit the surface of this invariant file (its `[mesh]` parameters included) instead
+    /// of presets; repeat the flag for several.
+    #[arg(long, value_name = "FILE", conflicts_with = "preset")]
+    pub invariant: Vec<PathBuf>,
     /// Print the rows as a JSON array instead of a table.
     #[arg(long)]
     pub json: bool,
@@ -28,7 +34,7 @@ pub const NO_MPFR_NOTE: &str =
 /// Formats rows as a fixed-width table (one row per line, the note last).
 pub fn format_table(rows: &[Row]) -> String {
     let header = [
-        "check", "scalar", "preset", "measured", "bound", "result", "note",
+        "check", "scalar", "surface", "measured", "bound", "result", "note",
     ];
     let cells: Vec<[String; 7]> = rows
         .iter()
@@ -93,7 +99,20 @@ pub(super) fn run(args: &AuditArgs) -> Result<ExitCode, CliError> {
     } else {
         args.preset.clone()
     };
-    let rows = audit::run_all(&presets);
+    let rows = if args.invariant.is_empty() {
+        audit::run_all(&presets)
+    } else {
+        let mut rows = Vec::new();
+        for path in &args.invariant {
+            let file = InvariantFile::read(path)?;
+            let label = path.file_stem().map_or_else(
+                || path.display().to_string(),
+                |s| s.to_string_lossy().into(),
+            );
+            rows.extend(audit::audit_field(&file.invariant, &file.params, &label));
+        }
+        rows
+    };
     let mut text = if args.json {
         let mut t = serde_json::to_string_pretty(&rows).map_err(|e| CliError::Write {
             path: "<standard output>".into(),

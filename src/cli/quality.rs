@@ -18,6 +18,10 @@ pub struct QualityArgs {
     /// Presets to measure (all six by default).
     #[arg(long, value_parser = super::preset_parser())]
     pub preset: Vec<Preset>,
+    /// Measure the surface of this invariant file (its `[mesh]` parameters included) instead
+    /// of presets; repeat the flag for several.
+    #[arg(long, value_name = "FILE", conflicts_with = "preset")]
+    pub invariant: Vec<PathBuf>,
     /// Print the rows as JSON.
     #[arg(long)]
     pub json: bool,
@@ -40,15 +44,23 @@ pub struct QualityRow {
 
 /// Meshes `preset` in `mode` and measures it.
 pub fn quality_row(preset: Preset, mode: Mode) -> Result<QualityRow, CliError> {
-    let invariant = preset.invariant();
-    let mut params = preset.params();
+    quality_row_of(preset.name(), &preset.invariant(), preset.params(), mode)
+}
+
+/// Meshes `invariant` with `params` in `mode` and measures it; `label` names it in the row.
+pub fn quality_row_of(
+    label: &str,
+    invariant: &Invariant,
+    mut params: liemesh::MeshParams,
+    mode: Mode,
+) -> Result<QualityRow, CliError> {
     params.mode = mode;
     let start = Instant::now();
-    let run = liemesh::run(&LieField::<f64>::new(&invariant), &params)?;
+    let run = liemesh::run(&LieField::<f64>::new(invariant), &params)?;
     let milliseconds = start.elapsed().as_secs_f64() * 1e3;
-    let quality = QualityReport::measure(&invariant, &params, &run.samples, &run.mesh);
+    let quality = QualityReport::measure(invariant, &params, &run.samples, &run.mesh);
     Ok(QualityRow {
-        preset: preset.name().into(),
+        preset: label.into(),
         mode: match mode {
             Mode::Default => "default".into(),
             Mode::Paper => "paper".into(),
@@ -66,9 +78,26 @@ pub(super) fn run(args: &QualityArgs) -> Result<ExitCode, CliError> {
         args.preset.clone()
     };
     let mut rows = Vec::new();
-    for p in presets {
+    if args.invariant.is_empty() {
+        for p in presets {
+            for mode in [Mode::Default, Mode::Paper] {
+                rows.push(quality_row(p, mode)?);
+            }
+        }
+    }
+    for path in &args.invariant {
+        let file = InvariantFile::read(path)?;
+        let label = path.file_stem().map_or_else(
+            || path.display().to_string(),
+            |s| s.to_string_lossy().into(),
+        );
         for mode in [Mode::Default, Mode::Paper] {
-            rows.push(quality_row(p, mode)?);
+            rows.push(quality_row_of(
+                &label,
+                &file.invariant,
+                file.params.clone(),
+                mode,
+            )?);
         }
     }
     if args.json {
@@ -78,7 +107,7 @@ pub(super) fn run(args: &QualityArgs) -> Result<ExitCode, CliError> {
         );
         return Ok(ExitCode::SUCCESS);
     }
-    println!("| preset | mode | triangles | min angle | 1% min angle | max face-normal error | drift max (rel.) | recovery error | integrability defect max | ms |");
+    println!("| surface | mode | triangles | min angle | 1% min angle | max face-normal error | drift max (rel.) | recovery error | integrability defect max | ms |");
     println!("|---|---|---:|---:|---:|---:|---:|---:|---:|---:|");
     for r in &rows {
         let q = &r.quality;

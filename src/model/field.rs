@@ -13,7 +13,8 @@ use crate::scalar::{Dual, Scalar, Vec3};
 /// cores at once (the result does not depend on how many).
 ///
 /// Implement it for every `T: Scalar` at once to be able to audit your field in `f32`, `f64`
-/// and MPFR:
+/// and MPFR (or write only the value as a [`crate::model::FieldFormula`] and let dual numbers
+/// give the JVP):
 ///
 /// ```
 /// use liemesh::model::NormalField;
@@ -184,12 +185,13 @@ impl<T: Scalar> NormalField<T> for LieField<T> {
 }
 
 /// A field given by a closure over dual numbers, so that one closure yields both the value
-/// and the Jacobian-vector product.
+/// and the Jacobian-vector product. The closure is tied to one scalar type; to run (and
+/// audit) a field in every precision, write it as a [`crate::model::FieldFormula`] instead.
 ///
 /// ```
 /// use liemesh::model::{FnField, NormalField};
 /// use liemesh::scalar::{Dual, Vec3};
-/// // A torus-like quartic's gradient, written once for Dual<f64>.
+/// // The gradient of |p|⁴/4 (its level sets are spheres), written for Dual<f64>.
 /// let field = FnField::new(|p: &Vec3<Dual<f64>>| {
 ///     let r2 = p.norm_squared();
 ///     p.scale(&r2)

@@ -4,12 +4,16 @@
 //! builds the matrices `A`, `B`, `C` and `H = [[A, B], [C, −Aᵀ]]` of the paper's eq. 2–4.
 //! Its normal field is `v(p) = A p + B (p∘p)`: the upper block of `H ℓ(p)` with the
 //! [`Lift`] `ℓ(p) = (p, p∘p)` (see DESIGN.md §1). The mesher never sees invariants, only a
-//! [`NormalField`], so users can mesh fields of their own ([`FnField`]).
+//! [`NormalField`], so users can mesh fields of their own: a formula written once for every
+//! scalar type ([`FieldFormula`] in a [`Formula`], which the audits can also run in every
+//! precision through [`EveryScalar`]) or a closure over dual numbers ([`FnField`]).
 
 mod field;
+mod formula;
 mod invariant;
 mod shape;
 
 pub use field::{jacobian, FnField, LieField, NormalField};
+pub use formula::{EveryScalar, FieldFormula, Formula};
 pub use invariant::{AngleReading, Invariant, InvariantError, InvariantKind, Lift, Mat3};
 pub use shape::{least_aligned_tangent, LocalShape, INTEGRABLE_DEFECT};
