@@ -265,3 +265,54 @@ pub fn generate<T: Scalar, F: NormalField<T>>(
 ) -> Result<Mesh, MeshError> {
     run(field, params).map(|r| r.mesh)
 }
+
+/// A mesh and the derivative of every vertex with respect to one parameter of the field.
+#[derive(Clone, Debug, PartialEq)]
+#[non_exhaustive]
+pub struct MeshDerivatives {
+    /// The mesh, identical to the `f64` run's (a dual number's real part rounds exactly as
+    /// `f64` does, so every discrete decision is the `f64` run's).
+    pub mesh: Mesh,
+    /// `d(vertex)/d(parameter)` for every vertex of [`MeshDerivatives::mesh`], with the
+    /// discrete decisions (steps, curves, triangles) held fixed.
+    pub d_vertices: Vec<[f64; 3]>,
+}
+
+/// Meshes `field`, whose parameter of interest is the dual variable, and returns the mesh with
+/// the derivative of every vertex with respect to that parameter: forward-mode AD through the
+/// whole pipeline, in one run.
+///
+/// For an invariant number, seed it with [`model::LieField::seeded`]; for a parameter of a
+/// field of one's own, write the field in `Dual<f64>` with the parameter as
+/// `Dual::variable(value)`.
+///
+/// ```
+/// use liemesh::model::{Invariant, LieField};
+/// use liemesh::{differentiate, MeshParams};
+///
+/// // The ellipsoid λ1 x² + 4y² + 16z² = 1 at λ1 = 1, and d(vertex)/dλ1.
+/// let invariant = Invariant::from_numbers(&[1.0, 4.0, 16.0, 0.0, 0.0, 0.0])?;
+/// let d = differentiate(&LieField::<f64>::seeded(&invariant, 0), &MeshParams::at([0.6, 0.4, 0.0]))?;
+/// // On the level set through p0, λ1 x² + … = λ1·0.36 + 0.64: differentiating,
+/// // x² + 2 (λ1 x dx + 4 y dy + 16 z dz) = 0.36 at every vertex.
+/// for (v, dv) in d.mesh.vertices.iter().zip(&d.d_vertices) {
+///     let lhs = v[0] * v[0] + 2.0 * (v[0] * dv[0] + 4.0 * v[1] * dv[1] + 16.0 * v[2] * dv[2]);
+///     assert!((lhs - 0.36).abs() < 1e-9, "{lhs}");
+/// }
+/// # Ok::<(), Box<dyn std::error::Error>>(())
+/// ```
+pub fn differentiate<F: NormalField<scalar::Dual<f64>>>(
+    field: &F,
+    params: &MeshParams,
+) -> Result<MeshDerivatives, MeshError> {
+    let run = run(field, params)?;
+    let d_vertices = run
+        .vertices
+        .iter()
+        .map(|v| [v.x.eps, v.y.eps, v.z.eps])
+        .collect();
+    Ok(MeshDerivatives {
+        mesh: run.mesh,
+        d_vertices,
+    })
+}

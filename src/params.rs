@@ -271,6 +271,23 @@ pub struct Resolved {
     pub bounding_box: f64,
 }
 
+impl Resolved {
+    /// The parameters with every automatic value written out: meshing another field with
+    /// them takes the same `w00`, steps and terminal conditions as this run (what a
+    /// comparison of two nearby fields, e.g. a central difference, needs).
+    pub fn explicit(&self) -> MeshParams {
+        MeshParams {
+            w00: Some(self.w00),
+            dt: Some(self.dt),
+            dt_min: Some(self.dt_min),
+            dt_max: Some(self.dt_max),
+            max_radius: Some(self.max_radius),
+            bounding_box: Some(self.bounding_box),
+            ..self.given.clone()
+        }
+    }
+}
+
 impl std::ops::Deref for Resolved {
     type Target = MeshParams;
     fn deref(&self) -> &MeshParams {

@@ -191,3 +191,54 @@ fn audit_and_quality_take_invariant_files() {
     assert!(!out.status.success());
     assert!(String::from_utf8_lossy(&out.stderr).contains("no/such/file.toml"));
 }
+
+#[test]
+fn derivatives_are_written_as_ply_properties_and_in_the_report() {
+    let dir = scratch("derivatives");
+    let (ply, json) = (dir.join("fig3.ply"), dir.join("fig3.json"));
+    let status = liemesh()
+        .args([
+            "mesh",
+            "--preset",
+            "fig3",
+            "--derivative",
+            "2",
+            "-q",
+            "--ascii",
+            "-o",
+        ])
+        .arg(&ply)
+        .arg("--report")
+        .arg(&json)
+        .status()
+        .unwrap();
+    assert!(status.success());
+    let text = std::fs::read_to_string(&ply).unwrap();
+    assert!(
+        text.contains("property double d_n2_x\nproperty double d_n2_y\nproperty double d_n2_z\n")
+    );
+    let report: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    let d = &report["derivatives"][0];
+    assert_eq!(d["number"], 2);
+    assert_eq!(
+        d["values"].as_array().unwrap().len(),
+        report["vertices"].as_u64().unwrap() as usize
+    );
+    assert!(d["max_norm"].as_f64().unwrap() > 0.1);
+    // The file still reads as a mesh (readers skip properties they do not know).
+    let mesh = liemesh::io::read_mesh(&ply).unwrap();
+    assert_eq!(mesh.vertices.len(), d["values"].as_array().unwrap().len());
+    // Bad numbers and formats are usage errors.
+    for args in [
+        ["--derivative", "19", "-o", "x.ply"],
+        ["--derivative", "2", "-o", "x.obj"],
+    ] {
+        let out = liemesh()
+            .args(["mesh", "--preset", "fig3", "-q"])
+            .args(args)
+            .output()
+            .unwrap();
+        assert_eq!(out.status.code(), Some(2), "{args:?}");
+    }
+}

@@ -3,7 +3,7 @@
 use super::CliError;
 use clap::Args;
 use liemesh::io::invariant_file::InvariantFile;
-use liemesh::io::report::Report;
+use liemesh::io::report::{Report, VertexDerivatives};
 use liemesh::io::{self, WriteOptions};
 use liemesh::model::{AngleReading, Invariant, LieField};
 use liemesh::preset::Preset;
@@ -26,6 +26,11 @@ pub struct MeshArgs {
     /// paper's eq. 2, A = diag(λ) R; `quadric` is A = Rᵀ diag(λ) R, a turned quadric.
     #[arg(long, value_enum, value_name = "READING")]
     pub angles: Option<AnglesArg>,
+    /// Also write d(vertex)/d(invariant number N) for every vertex, N counting from 1 in the
+    /// invariant's 6 numbers (or the 18 of Table 2's rows): PLY vertex properties `d_nN_x`,
+    /// `d_nN_y`, `d_nN_z` and the report's `derivatives`. Repeat for several numbers.
+    #[arg(long, value_name = "N")]
+    pub derivative: Vec<usize>,
     /// Output mesh: .ply (binary unless --ascii), .obj or .stl.
     #[arg(short, long, value_name = "FILE")]
     pub output: Option<PathBuf>,
@@ -242,6 +247,7 @@ impl MeshArgs {
             preset: Some(Preset::Fig6),
             invariant: None,
             angles: None,
+            derivative: Vec::new(),
             output: Some(PathBuf::from("out/fig6.ply")),
             ascii: false,
             report: Some(PathBuf::from("out/fig6.json")),
@@ -399,14 +405,9 @@ pub(super) fn run(args: &MeshArgs) -> Result<ExitCode, CliError> {
             args.report.is_some() || args.json,
         )
     })?;
+    let derivatives = derivatives(args, &invariant, &params, &outcome.mesh)?;
     if let Some(out) = &args.output {
-        io::write_mesh(
-            &outcome.mesh,
-            out,
-            &WriteOptions {
-                ply_ascii: args.ascii,
-            },
-        )?;
+        write_mesh_with(args, out, &outcome.mesh, &derivatives)?;
     }
     if let Some(png) = &args.png {
         super::picture::render_to_file(&outcome.mesh, png, &args.picture.options())?;
@@ -421,6 +422,7 @@ pub(super) fn run(args: &MeshArgs) -> Result<ExitCode, CliError> {
         &params,
     );
     outcome.fill(&mut report);
+    report.derivatives = derivatives;
     if let Some(path) = &args.report {
         write_json(path, &report)?;
     }
@@ -433,6 +435,108 @@ pub(super) fn run(args: &MeshArgs) -> Result<ExitCode, CliError> {
         print_summary(&report, args.output.as_deref(), args.report.as_deref());
     }
     Ok(ExitCode::SUCCESS)
+}
+
+/// The derivatives `--derivative` asks for: one dual-number run per number, whose mesh must
+/// be the `f64` run's.
+fn derivatives(
+    args: &MeshArgs,
+    invariant: &Invariant,
+    params: &MeshParams,
+    mesh: &Mesh,
+) -> Result<Vec<VertexDerivatives>, CliError> {
+    if args.derivative.is_empty() {
+        return Ok(Vec::new());
+    }
+    if args.scalar != ScalarArg::F64 {
+        return Err(CliError::Usage(
+            "--derivative differentiates the f64 run: leave out --scalar or give --scalar f64"
+                .into(),
+        ));
+    }
+    if let Some(out) = &args.output {
+        if io::MeshFormat::from_path(out)? != io::MeshFormat::Ply {
+            return Err(CliError::Usage(format!(
+                "--derivative writes PLY vertex properties: give an output ending in .ply, not {}",
+                out.display()
+            )));
+        }
+    }
+    let count = invariant.numbers().len();
+    let mut out = Vec::new();
+    for &number in &args.derivative {
+        if number == 0 || number > count {
+            return Err(CliError::Usage(format!(
+                "--derivative {number}: the invariant has {count} numbers, counted from 1"
+            )));
+        }
+        // The 6 numbers of a linear invariant are the first row of the 18-number layout.
+        let index = number - 1;
+        let d = liemesh::differentiate(&LieField::<f64>::seeded(invariant, index), params)?;
+        if d.mesh.vertices != mesh.vertices || d.mesh.triangles != mesh.triangles {
+            return Err(CliError::Usage(format!(
+                "--derivative {number}: the dual-number run decided differently from the f64 \
+                 run (this is a bug; please report it with the invariant file)"
+            )));
+        }
+        out.push(VertexDerivatives::new(number, d.d_vertices));
+    }
+    Ok(out)
+}
+
+/// Writes the mesh, with the derivatives as PLY vertex properties when there are any.
+fn write_mesh_with(
+    args: &MeshArgs,
+    out: &Path,
+    mesh: &Mesh,
+    derivatives: &[VertexDerivatives],
+) -> Result<(), CliError> {
+    if derivatives.is_empty() {
+        io::write_mesh(
+            mesh,
+            out,
+            &WriteOptions {
+                ply_ascii: args.ascii,
+            },
+        )?;
+        return Ok(());
+    }
+    let stems: Vec<String> = derivatives
+        .iter()
+        .map(|d| VertexDerivatives::stem(d.number))
+        .collect();
+    let extra: Vec<io::VertexVectors> = derivatives
+        .iter()
+        .zip(&stems)
+        .map(|(d, stem)| io::VertexVectors {
+            name: stem,
+            values: &d.values,
+        })
+        .collect();
+    let encoding = if args.ascii {
+        io::PlyEncoding::Ascii
+    } else {
+        io::PlyEncoding::BinaryLittleEndian
+    };
+    let write = || -> Result<(), io::IoError> {
+        if let Some(dir) = out.parent().filter(|d| !d.as_os_str().is_empty()) {
+            std::fs::create_dir_all(dir).map_err(|source| io::IoError::Io {
+                path: dir.to_path_buf(),
+                source,
+            })?;
+        }
+        let file = std::fs::File::create(out).map_err(|source| io::IoError::Io {
+            path: out.to_path_buf(),
+            source,
+        })?;
+        let mut w = std::io::BufWriter::new(file);
+        io::write_ply_with(mesh, &extra, &mut w, encoding)?;
+        std::io::Write::flush(&mut w).map_err(|source| io::IoError::Io {
+            path: out.to_path_buf(),
+            source,
+        })
+    };
+    Ok(write()?)
 }
 
 /// Runs `work`; if it takes longer than a second and standard error is a terminal, shows a

@@ -47,7 +47,7 @@ pub mod stl;
 // ---------------------------------------------------------------------------
 
 pub use obj::{read_obj, write_obj};
-pub use ply::{read_ply, write_ply, PlyEncoding};
+pub use ply::{read_ply, write_ply, write_ply_with, PlyEncoding, VertexVectors};
 pub use stl::write_stl;
 
 /// The mesh file formats liemesh knows, chosen by file extension.

@@ -71,13 +71,66 @@ pub enum PlyEncoding {
 /// [`IoError::InvalidMesh`] if the mesh breaks the [`Mesh`] invariants or
 /// holds non-finite values (nothing is written then); [`IoError::Io`] (with
 /// an empty path) if `w` fails.
-pub fn write_ply<W: Write>(mesh: &Mesh, mut w: W, encoding: PlyEncoding) -> Result<(), IoError> {
+pub fn write_ply<W: Write>(mesh: &Mesh, w: W, encoding: PlyEncoding) -> Result<(), IoError> {
+    write_ply_with(mesh, &[], w, encoding)
+}
+
+/// One vector per vertex, written by [`write_ply_with`] as three `double` vertex properties
+/// `{name}_x`, `{name}_y`, `{name}_z` after the standard ones (e.g. the derivatives of the
+/// vertices with respect to a parameter). Readers that do not know them skip them.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct VertexVectors<'a> {
+    /// The property names' stem: letters, digits and `_`.
+    pub name: &'a str,
+    /// One vector per vertex of the mesh.
+    pub values: &'a [[f64; 3]],
+}
+
+/// [`write_ply`] with extra per-vertex vectors.
+///
+/// # Errors
+///
+/// As [`write_ply`]; also [`IoError::InvalidMesh`] when an extra has not one vector per
+/// vertex, a non-finite value or a name other than letters, digits and `_`.
+pub fn write_ply_with<W: Write>(
+    mesh: &Mesh,
+    extra: &[VertexVectors],
+    mut w: W,
+    encoding: PlyEncoding,
+) -> Result<(), IoError> {
     check_mesh(mesh)?;
-    write_ply_unchecked(mesh, &mut w, encoding).map_err(IoError::stream)
+    for e in extra {
+        let problem = if e.values.len() != mesh.vertices.len() {
+            Some(format!(
+                "{} vectors for {} vertices",
+                e.values.len(),
+                mesh.vertices.len()
+            ))
+        } else if e.name.is_empty()
+            || !e
+                .name
+                .chars()
+                .all(|c| c.is_ascii_alphanumeric() || c == '_')
+        {
+            Some("the name must be letters, digits and `_`".to_string())
+        } else if e.values.iter().flatten().any(|x| !x.is_finite()) {
+            Some("a value is not finite".to_string())
+        } else {
+            None
+        };
+        if let Some(problem) = problem {
+            return Err(IoError::InvalidMesh {
+                path: Default::default(),
+                reason: format!("vertex property '{}': {problem}", e.name),
+            });
+        }
+    }
+    write_ply_unchecked(mesh, extra, &mut w, encoding).map_err(IoError::stream)
 }
 
 fn write_ply_unchecked<W: Write>(
     mesh: &Mesh,
+    extra: &[VertexVectors],
     w: &mut W,
     encoding: PlyEncoding,
 ) -> std::io::Result<()> {
@@ -100,11 +153,19 @@ fn write_ply_unchecked<W: Write>(
          property uint curve\n\
          property uint step\n\
          property double s\n\
-         property double theta\n\
-         element face {}\n\
+         property double theta\n",
+        mesh.vertices.len(),
+    )?;
+    for e in extra {
+        for axis in ["x", "y", "z"] {
+            writeln!(w, "property double {}_{axis}", e.name)?;
+        }
+    }
+    write!(
+        w,
+        "element face {}\n\
          property list uchar uint vertex_indices\n\
          end_header\n",
-        mesh.vertices.len(),
         mesh.triangles.len()
     )?;
     let vertices = mesh
@@ -114,7 +175,7 @@ fn write_ply_unchecked<W: Write>(
         .zip(&mesh.provenance);
     match encoding {
         PlyEncoding::BinaryLittleEndian => {
-            for ((p, n), prov) in vertices {
+            for (i, ((p, n), prov)) in vertices.enumerate() {
                 let mut record = [0u8; 72];
                 let reals = p.iter().chain(n);
                 for (chunk, x) in record[..48].chunks_exact_mut(8).zip(reals) {
@@ -125,6 +186,11 @@ fn write_ply_unchecked<W: Write>(
                 record[56..64].copy_from_slice(&prov.s.to_le_bytes());
                 record[64..72].copy_from_slice(&prov.theta.to_le_bytes());
                 w.write_all(&record)?;
+                for e in extra {
+                    for x in e.values[i] {
+                        w.write_all(&x.to_le_bytes())?;
+                    }
+                }
             }
             for t in &mesh.triangles {
                 let mut record = [3u8; 13];
@@ -135,12 +201,17 @@ fn write_ply_unchecked<W: Write>(
             }
         }
         PlyEncoding::Ascii => {
-            for ((p, n), prov) in vertices {
-                writeln!(
+            for (i, ((p, n), prov)) in vertices.enumerate() {
+                write!(
                     w,
                     "{} {} {} {} {} {} {} {} {} {}",
                     p[0], p[1], p[2], n[0], n[1], n[2], prov.curve, prov.step, prov.s, prov.theta
                 )?;
+                for e in extra {
+                    let [x, y, z] = e.values[i];
+                    write!(w, " {x} {y} {z}")?;
+                }
+                writeln!(w)?;
             }
             for t in &mesh.triangles {
                 writeln!(w, "3 {} {} {}", t[0], t[1], t[2])?;
@@ -997,6 +1068,41 @@ mod tests {
     fn assert_identical(a: &Mesh, b: &Mesh) {
         assert_eq!(bits(a), bits(b));
         assert_eq!(a.triangles, b.triangles);
+    }
+
+    #[test]
+    fn extra_vertex_vectors_are_written_and_skipped_on_reading() {
+        let mesh = sample_mesh();
+        let values: Vec<[f64; 3]> = (0..mesh.vertices.len())
+            .map(|i| [i as f64, -0.5, 1e-300])
+            .collect();
+        let extra = [VertexVectors {
+            name: "d_n2",
+            values: &values,
+        }];
+        for encoding in [PlyEncoding::Ascii, PlyEncoding::BinaryLittleEndian] {
+            let mut out = Vec::new();
+            write_ply_with(&mesh, &extra, &mut out, encoding).unwrap();
+            let header = String::from_utf8_lossy(&out[..out.len().min(600)]).into_owned();
+            assert!(
+                header.contains("property double d_n2_z\nelement face"),
+                "{header}"
+            );
+            assert_identical(&read(&out).unwrap(), &mesh);
+        }
+        // One vector per vertex, finite, and a plain name.
+        let short = [VertexVectors {
+            name: "d",
+            values: &values[1..],
+        }];
+        let bad_name = [VertexVectors {
+            name: "d n",
+            values: &values,
+        }];
+        for extra in [&short, &bad_name] {
+            let e = write_ply_with(&mesh, extra, Vec::new(), PlyEncoding::Ascii).unwrap_err();
+            assert!(matches!(e, IoError::InvalidMesh { .. }), "{e}");
+        }
     }
 
     /// Vertices with awkward values: tiny, huge, subnormal, negative zero, 1/3.

@@ -70,6 +70,49 @@ pub struct Report {
         serde(default, skip_serializing_if = "Option::is_none")
     )]
     pub refinement: Option<crate::triangulate::Refinement>,
+    /// The derivatives of the vertices with respect to invariant numbers, when asked for.
+    #[cfg_attr(
+        feature = "serde",
+        serde(default, skip_serializing_if = "Vec::is_empty")
+    )]
+    pub derivatives: Vec<VertexDerivatives>,
+}
+
+/// `d(vertex)/d(number)` for every vertex, with respect to one invariant number
+/// ([`crate::differentiate`]).
+#[derive(Clone, Debug, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+pub struct VertexDerivatives {
+    /// The invariant number, counting from 1 in [`Invariant::numbers`] (6 numbers, or the
+    /// 18 of Table 2's three rows).
+    pub number: usize,
+    /// The PLY vertex properties that hold them (`{stem}_x`, `{stem}_y`, `{stem}_z`).
+    pub ply_properties: [String; 3],
+    /// The largest `|d(vertex)/d(number)|`.
+    pub max_norm: f64,
+    /// One derivative per vertex, in the mesh's vertex order.
+    pub values: Vec<[f64; 3]>,
+}
+
+impl VertexDerivatives {
+    /// The PLY property stem for invariant number `number` (from 1): `d_n{number}`.
+    pub fn stem(number: usize) -> String {
+        format!("d_n{number}")
+    }
+
+    /// The summary of `values`, the derivatives with respect to invariant number `number`.
+    pub fn new(number: usize, values: Vec<[f64; 3]>) -> VertexDerivatives {
+        let stem = Self::stem(number);
+        VertexDerivatives {
+            number,
+            ply_properties: ["x", "y", "z"].map(|a| format!("{stem}_{a}")),
+            max_norm: values
+                .iter()
+                .map(|d| (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt())
+                .fold(0.0, f64::max),
+            values,
+        }
+    }
 }
 
 impl Report {
@@ -106,6 +149,7 @@ impl Report {
             validation: None,
             quality: None,
             refinement: None,
+            derivatives: Vec::new(),
         }
     }
 }
