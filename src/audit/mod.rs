@@ -27,14 +27,13 @@
 pub mod field;
 pub mod jvp;
 pub mod prediction;
-mod rng;
 pub mod scalars;
 
 use crate::model::Invariant;
 use crate::preset::Preset;
 
+pub use crate::geom::rng::XorShift64;
 pub use field::audit_field;
-pub use rng::XorShift64;
 
 /// Whether this build has the `mpfr` feature, i.e. whether the MPFR rows are produced.
 pub const MPFR_AVAILABLE: bool = cfg!(feature = "mpfr");

@@ -702,7 +702,7 @@ impl FaceGrid {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::audit::XorShift64;
+    use crate::geom::rng::XorShift64;
 
     fn random_boxes(rng: &mut XorShift64, n: usize, outliers: usize) -> Vec<Aabb> {
         let mut boxes: Vec<Aabb> = (0..n)

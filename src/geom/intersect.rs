@@ -427,8 +427,8 @@ fn folded_onto<O: Orient>(o: O, a: P3, b: P3, c: P3, d: P3) -> bool {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::audit::XorShift64;
     use crate::geom::predicates::InRange;
+    use crate::geom::rng::XorShift64;
 
     fn tri(a: [f64; 3], b: [f64; 3], c: [f64; 3]) -> Tri {
         [a, b, c]

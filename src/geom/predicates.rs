@@ -463,7 +463,7 @@ mod exact {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::audit::XorShift64;
+    use crate::geom::rng::XorShift64;
 
     #[test]
     fn conventions() {

@@ -612,8 +612,8 @@ fn geometry<O: Orient + Sync>(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::audit::XorShift64;
     use crate::geom::intersect::{faces_intersect, triangle_is_degenerate};
+    use crate::geom::rng::XorShift64;
     use crate::mesh::octahedron;
     use proptest::prelude::*;
 

@@ -1,5 +1,6 @@
 //! How faithful the samples and the mesh are to the field.
 
+use crate::geom::face_error_deg;
 use crate::model::{jacobian, Invariant, NormalField};
 use crate::sample::Samples;
 use crate::scalar::{Scalar, Vec3};
@@ -93,27 +94,6 @@ pub fn face_normal_error<F: NormalField<f64>>(field: &F, mesh: &Mesh) -> (f64, f
     }
     let n = mesh.triangles.len().max(1) as f64;
     (max, sum / n)
-}
-
-/// One face's normal error: the angle in degrees between the face with `corners` and
-/// `normal_at` its centroid; 180 when that angle is NaN (a non-finite corner or field value),
-/// so that such a face counts as the worst.
-///
-/// This is the error [`face_normal_error`] sums up and refinement to
-/// [`MeshParams::max_normal_error`](crate::MeshParams::max_normal_error) bounds.
-pub fn face_error_deg(
-    corners: [[f64; 3]; 3],
-    normal_at: impl FnOnce(&Vec3<f64>) -> Vec3<f64>,
-) -> f64 {
-    let [a, b, c] = corners.map(Vec3::from_f64);
-    let face = (&b - &a).cross(&(&c - &a));
-    let centroid = (&(&a + &b) + &c).scale(&(1.0 / 3.0));
-    let e = angle_deg(&face, &normal_at(&centroid));
-    if e.is_nan() {
-        180.0
-    } else {
-        e
-    }
 }
 
 /// Vertex drift from the level set through `p0`, for fields with a known potential.

@@ -9,9 +9,9 @@ mod recover;
 mod shape;
 mod topology;
 
+pub use crate::geom::face_error_deg;
 pub use fidelity::{
-    diagonal, drift, face_error_deg, face_normal_error, integrability_defect, step_quality, Drift,
-    StepQuality,
+    diagonal, drift, face_normal_error, integrability_defect, step_quality, Drift, StepQuality,
 };
 pub use recover::{decompose, decompose_in, jet_normals, mesh_normals, recover, Recovery};
 pub use shape::Shape;

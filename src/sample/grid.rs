@@ -143,7 +143,7 @@ mod tests {
 
     /// Deterministic points on the unit sphere.
     fn sphere_points(n: usize) -> Vec<[f64; 3]> {
-        let mut rng = crate::audit::XorShift64::new(3);
+        let mut rng = crate::geom::rng::XorShift64::new(3);
         (0..n).map(|_| rng.unit_vector()).collect()
     }
 

@@ -797,7 +797,7 @@ mod tests {
 
     #[test]
     fn against_field_is_the_sign_of_the_agreement() {
-        let mut rng = crate::audit::XorShift64::new(17);
+        let mut rng = crate::geom::rng::XorShift64::new(17);
         let mut against = 0;
         for k in 0..30_000 {
             // Ordinary scales for half the faces, from underflow to overflow for the rest, and

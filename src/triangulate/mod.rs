@@ -656,7 +656,7 @@ fn assemble<T: Scalar>(samples: &Samples<T>, pos: &[[f64; 3]], triangles: &[[u32
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::audit::XorShift64;
+    use crate::geom::rng::XorShift64;
 
     /// A polygon star-shaped about the origin: `m` vertices at increasing angles.
     fn star(rng: &mut XorShift64, m: usize, wobble: f64) -> Vec<[f64; 2]> {

@@ -19,9 +19,9 @@
 use super::flip::{against_field, agreement_at, HalfEdges};
 use super::relax::{towards_centroid, DAMPING, MIN_AGREEMENT};
 use super::{Mesh, Provenance};
+use crate::geom::face_error_deg;
 use crate::par;
 use crate::params::Resolved;
-use crate::quality::face_error_deg;
 use crate::scalar::{Scalar, Vec3};
 use crate::trace::{self, StepConfig};
 use crate::NormalField;
