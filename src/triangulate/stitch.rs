@@ -24,6 +24,14 @@
 //! meets in two pairs of arcs becomes a torus; boundary that faces nothing (a geodesic radius,
 //! the bounding box) stays boundary.
 //!
+//! Holes that the front leaves open between fronts that met (no vertex of theirs ended a curve
+//! on a terminal condition) are, on an integrable field, filled through a chart of their own at
+//! the end: the hole's loop is projected onto the plane across its mean field normal,
+//! triangulated there by spade's constrained Delaunay refinement with the loop's edges kept
+//! whole, and the new points are put on the surface by short chords. The patch goes in only if
+//! it stays a graph over that plane, faces the field and meets nothing (exact test); a hole
+//! whose patch does not fit is opened one ring of triangles wider and tried again.
+//!
 //! A triangle may touch a boundary vertex from outside its fan (a bridge across a gap); that
 //! vertex is pinched until the gaps beside the bridge are closed too. Pinches that remain at the
 //! end are cut apart by removing the fewer triangles of the vertex.
@@ -34,6 +42,7 @@ use crate::mesh::{Mesh, Provenance};
 use crate::scalar::{Scalar, Vec3};
 use crate::trace::{self, StepConfig};
 use crate::NormalField;
+use spade::{ConstrainedDelaunayTriangulation, Point2, Triangulation as _};
 use std::collections::{BinaryHeap, HashMap, HashSet};
 
 /// Candidate vertices lie within this many local edge lengths of both ends of the edge.
@@ -98,6 +107,21 @@ pub(crate) enum Rim {
 
 /// A removed triangle, until the end of the stitching.
 const DEAD: [u32; 3] = [u32::MAX; 3];
+
+/// Holes left between fronts that met, of at most this many edges, are filled through a chart
+/// of their own (see [`Stitcher::fill_by_chart`]).
+const CHART_HOLE: usize = 600;
+/// A hole filled through its own chart: every corner's field normal, and every new point's,
+/// within this many degrees of the hole's mean normal (the surface there is a graph over the
+/// chart's plane).
+const CHART_TURN_DEG: f64 = 70.0;
+/// Times a hole that its chart could not fill is opened one ring wider and tried again.
+const CHART_ATTEMPTS: usize = 4;
+/// Most chords a new point of a hole's chart is reached by (each at most the loop's mean
+/// edge length).
+const CHART_HOPS: usize = 64;
+/// Smallest angle spade's refinement aims for inside a hole's chart, degrees.
+const CHART_ANGLE_DEG: f64 = 25.0;
 
 /// Times the stitching opens holes that stayed open and runs again.
 const REDO_ROUNDS: usize = 5;
@@ -244,6 +268,9 @@ pub(crate) fn stitch<T: Scalar, F: NormalField<T>>(
         out.removed += removed;
         opened = Some(near);
     }
+    // Holes that are still open between fronts that met are filled through charts of their
+    // own, opened wider where that fails.
+    out.added += s.fill_holes_by_chart(&mut out);
     // Pinches left after the last round are cut apart (only stitched triangles' vertices can
     // be pinched).
     let touched = s.touched();
@@ -948,6 +975,350 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
         true
     }
 
+    /// The last resort for holes between fronts that met (every vertex of the loop
+    /// [`Rim::Open`], at most [`CHART_HOLE`] edges, on an integrable field): each is filled
+    /// through a chart of its own ([`Self::fill_by_chart`]); a hole whose chart fails is
+    /// opened one ring wider and tried again, up to [`CHART_ATTEMPTS`] times. Returns how
+    /// many triangles it added (and counts the removed ones and the new vertices in `out`).
+    fn fill_holes_by_chart(&mut self, out: &mut Stitched) -> usize {
+        if !self.growth.new_points {
+            return 0;
+        }
+        let mut added = 0;
+        for attempt in 0..=CHART_ATTEMPTS {
+            let loops = self.open_loops(CHART_HOLE);
+            let mut failed = Vec::new();
+            for ring in loops {
+                match self.fill_by_chart(&ring) {
+                    Some((triangles, vertices)) => {
+                        added += triangles;
+                        out.vertices += vertices;
+                    }
+                    None => failed.push(ring),
+                }
+            }
+            if failed.is_empty() || attempt == CHART_ATTEMPTS {
+                break;
+            }
+            let (removed, _) = self.open_around(&failed, attempt + 1);
+            out.removed += removed;
+        }
+        added
+    }
+
+    /// The simple boundary loops of at most `limit` edges none of whose vertices ended a
+    /// curve on a terminal condition: holes left where fronts met. Each loop once, in a
+    /// deterministic order.
+    fn open_loops(&self, limit: usize) -> Vec<Vec<u32>> {
+        let mut seen: HashSet<u32, FastHash> = HashSet::default();
+        let mut out = Vec::new();
+        for (a, b) in self.boundary_edge_list() {
+            if seen.contains(&a) {
+                continue;
+            }
+            let Some(ring) = self.loop_from((a, b), limit) else {
+                continue;
+            };
+            seen.extend(ring.iter().copied());
+            if ring.len() >= 3 && ring.iter().all(|&v| self.rim[v as usize] == Rim::Open) {
+                out.push(ring);
+            }
+        }
+        out
+    }
+
+    /// Fills the hole bounded by `ring` (a boundary loop, the hole on the right of each edge)
+    /// through a chart of its own: the loop is projected onto the plane across its corners'
+    /// mean field normal, triangulated there by spade (the loop's edges as constraints, kept
+    /// whole, refined to [`CHART_ANGLE_DEG`] with triangles about the loop's edge length),
+    /// and each new point is put on the surface by a chord from the nearest corner. The patch
+    /// goes in only if every corner and new point faces within [`CHART_TURN_DEG`] of the
+    /// plane's normal, every triangle keeps its orientation once lifted, faces the field and
+    /// meets no triangle already there (exact test). Returns the triangles and vertices added.
+    fn fill_by_chart(&mut self, ring: &[u32]) -> Option<(usize, usize)> {
+        use spade::{AngleLimit, RefinementParameters};
+        let m = ring.len();
+        if m < 3 || self.pos.len() + 4 * m + 64 > self.growth.max_vertices {
+            return None;
+        }
+        let turn_cos = CHART_TURN_DEG.to_radians().cos();
+        let mut sum = [0.0; 3];
+        let mut centre = [0.0; 3];
+        for &v in ring {
+            for k in 0..3 {
+                sum[k] += self.nrm[v as usize][k];
+                centre[k] += self.pos[v as usize][k] / m as f64;
+            }
+        }
+        let length = dot(sum, sum).sqrt();
+        if !(length > 0.0) {
+            return None;
+        }
+        let n = sum.map(|x| x / length);
+        if ring
+            .iter()
+            .any(|&v| !(dot(self.nrm[v as usize], n) > turn_cos))
+        {
+            return None;
+        }
+        // A frame right-handed about n: counter-clockwise in the chart is counter-clockwise
+        // about the normal, the mesh's orientation.
+        let helper = if n[0].abs() < 0.9 {
+            [1.0, 0.0, 0.0]
+        } else {
+            [0.0, 1.0, 0.0]
+        };
+        let e1 = unit(cross(helper, n));
+        let e2 = cross(n, e1);
+        let chart = |q: [f64; 3]| {
+            let d = sub(q, centre);
+            [dot(d, e1), dot(d, e2)]
+        };
+        // The hole runs counter-clockwise once the loop is reversed.
+        let corners2: Vec<[f64; 2]> = ring
+            .iter()
+            .rev()
+            .map(|&v| chart(self.pos[v as usize]))
+            .collect();
+        let ids: Vec<u32> = ring.iter().rev().copied().collect();
+        let area: f64 = (0..m)
+            .map(|i| {
+                let (p, q) = (corners2[i], corners2[(i + 1) % m]);
+                p[0] * q[1] - q[0] * p[1]
+            })
+            .sum::<f64>()
+            * 0.5;
+        if !(area > 0.0) || !simple_polygon(&corners2) {
+            return None;
+        }
+        let mean_edge = (0..m)
+            .map(|i| {
+                dist(
+                    self.pos[ids[i] as usize],
+                    self.pos[ids[(i + 1) % m] as usize],
+                )
+            })
+            .sum::<f64>()
+            / m as f64;
+        // A frame of four far corners keeps the hole off the convex hull, whose edges the
+        // refinement may split.
+        let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
+        for c in &corners2 {
+            for k in 0..2 {
+                lo[k] = lo[k].min(c[k]);
+                hi[k] = hi[k].max(c[k]);
+            }
+        }
+        let pad = (hi[0] - lo[0]).max(hi[1] - lo[1]) + mean_edge;
+        let mut cdt: ConstrainedDelaunayTriangulation<Point2<f64>> = Default::default();
+        for (x, y) in [
+            (lo[0] - pad, lo[1] - pad),
+            (hi[0] + pad, lo[1] - pad),
+            (hi[0] + pad, hi[1] + pad),
+            (lo[0] - pad, hi[1] + pad),
+        ] {
+            cdt.insert(Point2::new(x, y)).ok()?;
+        }
+        let mut handles = Vec::with_capacity(m);
+        for c in &corners2 {
+            let h = cdt.insert(Point2::new(c[0], c[1])).ok()?;
+            if h.index() != 4 + handles.len() {
+                // Two corners at one chart position.
+                return None;
+            }
+            handles.push(h);
+        }
+        for i in 0..m {
+            let (a, b) = (handles[i], handles[(i + 1) % m]);
+            if !cdt.can_add_constraint(a, b) {
+                return None;
+            }
+            cdt.add_constraint(a, b);
+        }
+        let equilateral = 0.25 * 3f64.sqrt() * mean_edge * mean_edge;
+        let result = cdt.refine(
+            RefinementParameters::new()
+                .exclude_outer_faces(true)
+                .keep_constraint_edges()
+                .with_angle_limit(AngleLimit::from_deg(CHART_ANGLE_DEG))
+                .with_max_allowed_area(1.5 * equilateral)
+                .with_min_required_area(0.05 * equilateral)
+                .with_max_additional_vertices(8 * m + 64),
+        );
+        // The loop's edges must have stayed whole: the patch is glued to them.
+        if (0..m).any(|i| {
+            cdt.get_edge_from_neighbors(handles[i], handles[(i + 1) % m])
+                .is_none()
+        }) {
+            return None;
+        }
+        let outer: HashSet<usize, FastHash> =
+            result.excluded_faces.iter().map(|f| f.index()).collect();
+        let faces: Vec<[usize; 3]> = cdt
+            .inner_faces()
+            .filter(|f| !outer.contains(&f.fix().index()))
+            .map(|f| f.vertices().map(|v| v.fix().index()))
+            .collect();
+        if faces.is_empty() || faces.iter().flatten().any(|&i| i < 4) {
+            return None;
+        }
+        // Chart vertex → mesh vertex: the loop's corners, then new points on trial.
+        let first_new = self.pos.len() as u32;
+        let mut index: HashMap<usize, u32, FastHash> = HashMap::default();
+        for (i, &v) in ids.iter().enumerate() {
+            index.insert(4 + i, v);
+        }
+        let mut steiner: Vec<usize> = faces
+            .iter()
+            .flatten()
+            .copied()
+            .filter(|i| *i >= 4 + m)
+            .collect();
+        steiner.sort_unstable();
+        steiner.dedup();
+        let s0 = ring
+            .iter()
+            .map(|&v| self.prov[v as usize].s)
+            .fold(f64::INFINITY, f64::min);
+        let theta = ring
+            .iter()
+            .map(|&v| self.prov[v as usize].theta)
+            .sum::<f64>()
+            / m as f64;
+        let mut lifted_ok = true;
+        for &i in &steiner {
+            let p2 = cdt
+                .vertex(spade::handles::FixedVertexHandle::from_index(i))
+                .position();
+            let target = [0, 1, 2].map(|k| centre[k] + p2.x * e1[k] + p2.y * e2[k]);
+            let Some(point) = self.lift(ids.as_slice(), target, n, turn_cos, mean_edge) else {
+                lifted_ok = false;
+                break;
+            };
+            let (q, normal, _) = point;
+            index.insert(i, self.pos.len() as u32);
+            self.pos.push(q);
+            self.nrm.push(normal);
+            self.prov.push(Provenance {
+                curve: Provenance::CLOSING_CURVE,
+                step: 0,
+                s: s0 + dist(q, centre),
+                theta,
+            });
+            self.work.push(point.2);
+            self.rim.push(Rim::Open);
+        }
+        let triangles: Vec<[u32; 3]> = faces
+            .iter()
+            .map(|f| f.map(|i| index.get(&i).copied().unwrap_or(u32::MAX)))
+            .collect();
+        let fits = lifted_ok
+            && triangles
+                .iter()
+                .all(|&t| !t.contains(&u32::MAX) && self.patch_triangle_fits(t, n, centre, e1, e2));
+        if !fits {
+            while self.pos.len() > first_new as usize {
+                self.retract();
+            }
+            return None;
+        }
+        for v in first_new..self.pos.len() as u32 {
+            self.scale.insert(v, mean_edge);
+            self.points.insert(v, self.pos[v as usize]);
+        }
+        for &t in &triangles {
+            self.add(t);
+        }
+        Some((triangles.len(), self.pos.len() - first_new as usize))
+    }
+
+    /// The point of the surface over chart point `target` (a chord from the nearest of
+    /// `corners`, in the working precision, in hops of at most `hop_length`), with its unit field normal, if that normal is
+    /// within `turn_cos` of the chart's normal `n`.
+    fn lift(
+        &self,
+        corners: &[u32],
+        target: [f64; 3],
+        n: [f64; 3],
+        turn_cos: f64,
+        hop_length: f64,
+    ) -> Option<([f64; 3], [f64; 3], Vec3<T>)> {
+        let from = *corners.iter().min_by(|&&u, &&v| {
+            dist(self.pos[u as usize], target)
+                .total_cmp(&dist(self.pos[v as usize], target))
+                .then(u.cmp(&v))
+        })?;
+        // Hops of at most one local edge length: the chord's truncation error grows with the
+        // fifth power of its length off cubic potentials.
+        let mut point = self.work[from as usize].clone();
+        let mut at = self.pos[from as usize];
+        for _ in 0..CHART_HOPS {
+            let d = sub(target, at);
+            let length = dot(d, d).sqrt();
+            if !(length > 0.0) {
+                return None;
+            }
+            let hop = length.min(hop_length);
+            point = trace::step_fixed(
+                self.growth.field,
+                &self.growth.cfg,
+                &point,
+                &Vec3::<T>::from_f64(d),
+                &T::from_f64(hop),
+            )
+            .ok()?;
+            at = point.to_f64();
+            if hop == length {
+                break;
+            }
+        }
+        let (_, normal, _) = trace::unit_normal(self.growth.field, &point).ok()?;
+        let (q, normal) = (point.to_f64(), normal.to_f64());
+        let finite = q.iter().chain(&normal).all(|x| x.is_finite());
+        (finite
+            && q.iter().all(|x| x.abs() <= self.growth.bounding_box)
+            && dot(normal, n) > turn_cos)
+            .then_some((q, normal, point))
+    }
+
+    /// Whether a triangle `t` of a hole's chart patch may go in: counter-clockwise in the
+    /// chart (frame `e1`, `e2` at `centre`) also after lifting, facing the field at each
+    /// corner within [`MAX_TILT_DEG`], and meeting no triangle already there (exact).
+    fn patch_triangle_fits(
+        &self,
+        t: [u32; 3],
+        n: [f64; 3],
+        centre: [f64; 3],
+        e1: [f64; 3],
+        e2: [f64; 3],
+    ) -> bool {
+        let c = corners(&self.pos, t);
+        let p2 = c.map(|q| {
+            let d = sub(q, centre);
+            [dot(d, e1), dot(d, e2)]
+        });
+        let turn = (p2[1][0] - p2[0][0]) * (p2[2][1] - p2[0][1])
+            - (p2[1][1] - p2[0][1]) * (p2[2][0] - p2[0][0]);
+        let face = cross(sub(c[1], c[0]), sub(c[2], c[0]));
+        let ff = dot(face, face);
+        let cos_tilt = MAX_TILT_DEG.to_radians().cos();
+        if !(turn > 0.0 && ff > 0.0 && dot(face, n) > 0.0) {
+            return false;
+        }
+        if t.iter().any(|&v| {
+            dot(face, self.nrm[v as usize])
+                < cos_tilt * (ff * dot(self.nrm[v as usize], self.nrm[v as usize])).sqrt()
+        }) {
+            return false;
+        }
+        let mut hit = false;
+        self.faces.near(&c, |f| {
+            let g = self.tris[f as usize];
+            hit = hit || (g != DEAD && faces_intersect(&self.pos, t, g));
+        });
+        !hit
+    }
+
     /// Whether triangle `t` keeps clear of the other vertices of `ring` (a loop's ear must
     /// not cover part of the loop).
     fn covers_none(&self, ring: &[u32], t: [u32; 3]) -> bool {
@@ -1116,6 +1487,40 @@ fn remove(list: Option<&mut Vec<u32>>, v: u32) -> bool {
         },
         None => false,
     }
+}
+
+/// Whether the closed polygon `p` is simple: no two edges meet but neighbours at their
+/// shared corner (floating-point orientation tests with a margin, erring on "not simple").
+fn simple_polygon(p: &[[f64; 2]]) -> bool {
+    let m = p.len();
+    let orient = |a: [f64; 2], b: [f64; 2], c: [f64; 2]| {
+        (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0])
+    };
+    let size = p
+        .iter()
+        .flat_map(|q| q.iter())
+        .fold(0.0f64, |s, x| s.max(x.abs()))
+        .max(f64::MIN_POSITIVE);
+    let eps = 1e-12 * size * size;
+    for i in 0..m {
+        let (a, b) = (p[i], p[(i + 1) % m]);
+        for j in i + 1..m {
+            if j == i + 1 || (i == 0 && j == m - 1) {
+                continue;
+            }
+            let (c, d) = (p[j], p[(j + 1) % m]);
+            let (o1, o2) = (orient(a, b, c), orient(a, b, d));
+            let (o3, o4) = (orient(c, d, a), orient(c, d, b));
+            let apart = (o1 > eps && o2 > eps)
+                || (o1 < -eps && o2 < -eps)
+                || (o3 > eps && o4 > eps)
+                || (o3 < -eps && o4 < -eps);
+            if !apart {
+                return false;
+            }
+        }
+    }
+    true
 }
 
 /// The distance from `p` to the triangle `t` (closed).
