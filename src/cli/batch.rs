@@ -6,6 +6,7 @@
 //! out (`seconds` is written as 0; the summary on standard output has the times).
 
 use super::mesh::{mesh_invariant, write_json};
+use super::progress::Status;
 use super::CliError;
 use clap::Args;
 use liemesh::io::invariant_file::InvariantFile;
@@ -96,7 +97,13 @@ fn mesh_one(input: &Path, out: &Path, format: MeshFormat) -> Result<BatchDone, C
     let t0 = Instant::now();
     let file = InvariantFile::read(input)?;
     let params = file.params;
-    let outcome = mesh_invariant(&file.invariant, &params, ScalarKind::F64, true)?;
+    let outcome = mesh_invariant(
+        &file.invariant,
+        &params,
+        ScalarKind::F64,
+        true,
+        &Status::default(),
+    )?;
     let stem = input.file_stem().unwrap_or_default().to_string_lossy();
     let mesh_path = out.join(format!("{stem}.{}", format.extension()));
     let report_path = out.join(format!("{stem}.json"));
