@@ -4,6 +4,9 @@
 //! Output files depend only on the inputs, never on the number of threads or on timing: each
 //! input is meshed by the same sequential pipeline, and the reports leave the wall-clock time
 //! out (`seconds` is written as 0; the summary on standard output has the times).
+//!
+//! Each failing input's error is printed once, on standard error; the table on standard
+//! output marks the input `FAILED`.
 
 use super::mesh::{mesh_invariant, write_json};
 use super::progress::Status;
@@ -162,7 +165,8 @@ pub fn run(args: &BatchArgs) -> Result<ExitCode, CliError> {
                     d.seconds * 1e3,
                     d.mesh.display()
                 ),
-                Err(e) => println!("{:<40} FAILED: {e}", item.input.display()),
+                // The error itself goes to standard error, once (below).
+                Err(_) => println!("{:<40} FAILED", item.input.display()),
             }
         }
         let cpu: f64 = items
