@@ -49,6 +49,7 @@ pub mod model;
 mod par;
 mod params;
 pub mod preset;
+pub mod progress;
 pub mod quality;
 pub mod sample;
 pub mod scalar;
@@ -59,6 +60,7 @@ pub use error::MeshError;
 pub use mesh::{Mesh, Provenance};
 pub use model::NormalField;
 pub use params::{Angle, MeshParams, Method, Mode, Resolved, Scales};
+pub use progress::{Progress, Stage};
 
 // The fuzz targets' checks (`fuzz/src/lib.rs`, written against the public API as
 // `liemesh::...`), compiled into the unit tests too.
@@ -168,9 +170,44 @@ pub struct Timings {
 /// flipped on rayon's current thread pool (call it inside rayon's `ThreadPool::install` to
 /// choose the threads); the result is bit-identical for any number of threads, and without
 /// the feature.
+///
+/// [`run_observed`] is the same run reporting its progress.
 pub fn run<T: Scalar, F: NormalField<T>>(
     field: &F,
     params: &MeshParams,
+) -> Result<MeshRun<T>, MeshError> {
+    run_observed(field, params, &|_| {})
+}
+
+/// [`run`], calling `observe` with a [`Progress`] report as each stage starts, every
+/// [`progress::SAMPLING_REPORT_EVERY`] steps of the sampling and as each refinement round
+/// starts (never from an inner loop). `observe` is called on the calling thread; the mesh
+/// is the same as [`run`]'s.
+///
+/// ```
+/// use liemesh::{model::{Invariant, LieField}, preset::Preset, Stage};
+/// use std::cell::RefCell;
+///
+/// let sphere = Invariant::from_numbers(&[1.0, 1.0, 1.0, 0.0, 0.0, 0.0])?;
+/// let field = LieField::<f64>::new(&sphere);
+/// let stages = RefCell::new(Vec::new());
+/// let run = liemesh::run_observed(&field, &Preset::Fig3.params(), &|p| {
+///     if stages.borrow().last() != Some(&p.stage) {
+///         stages.borrow_mut().push(p.stage);
+///     }
+/// })?;
+/// // The sphere closes (stitching runs) and is improved in the default mode.
+/// assert_eq!(
+///     stages.into_inner(),
+///     [Stage::Sampling, Stage::Triangulating, Stage::Stitching, Stage::Improving, Stage::Validating]
+/// );
+/// assert!(!run.mesh.triangles.is_empty());
+/// # Ok::<(), Box<dyn std::error::Error>>(())
+/// ```
+pub fn run_observed<T: Scalar, F: NormalField<T>>(
+    field: &F,
+    params: &MeshParams,
+    observe: &dyn Fn(Progress),
 ) -> Result<MeshRun<T>, MeshError> {
     let clock = std::time::Instant::now();
     let mut timings = Timings::default();
@@ -182,8 +219,10 @@ pub fn run<T: Scalar, F: NormalField<T>>(
     let mut since = 0.0;
     let resolved = params.resolve::<T, F>(field)?;
     let params = &resolved;
-    let samples = sample::sample_resolved(field, params)?;
+    let samples = sample::sample_resolved(field, params, observe)?;
     lap(&mut timings.sampling, &mut since);
+    let (points, curves) = (samples.points.len(), samples.curves.len());
+    observe(Progress::at(Stage::Triangulating, points, curves, 0));
     let improve = params.mode == Mode::Default;
     let (mut mesh, chart) = triangulate::triangulate(&samples, params.close, improve)?;
     // The mesh's vertices in the working precision, found by provenance.
@@ -196,6 +235,12 @@ pub fn run<T: Scalar, F: NormalField<T>>(
         })
         .collect();
     let stitched = if params.close {
+        observe(Progress::at(
+            Stage::Stitching,
+            mesh.vertices.len(),
+            curves,
+            mesh.triangles.len(),
+        ));
         triangulate::stitch(field, params, &samples, &mut mesh, &mut vertices)
     } else {
         Default::default()
@@ -209,16 +254,37 @@ pub fn run<T: Scalar, F: NormalField<T>>(
         working: vertices.clone(),
     });
     if improve {
+        observe(Progress::at(
+            Stage::Improving,
+            mesh.vertices.len(),
+            curves,
+            mesh.triangles.len(),
+        ));
         triangulate::relax(field, params, &mut mesh, &mut vertices);
     }
     lap(&mut timings.improving, &mut since);
-    let refinement = params
-        .max_normal_error
-        .map(|limit| triangulate::refine(field, params, limit.degrees(), &mut mesh, &mut vertices));
+    let refinement = params.max_normal_error.map(|limit| {
+        let (points, triangles) = (mesh.vertices.len(), mesh.triangles.len());
+        observe(Progress::at(Stage::Refining, points, curves, triangles));
+        let on_round = |round, points, triangles| {
+            observe(Progress {
+                round,
+                ..Progress::at(Stage::Refining, points, curves, triangles)
+            })
+        };
+        let limit = limit.degrees();
+        triangulate::refine(field, params, limit, &mut mesh, &mut vertices, &on_round)
+    });
     lap(&mut timings.refining, &mut since);
     // Validation, decided exactly; crossings are undone (see `triangulate::untangle`).
     // Fans that meet only at a vertex are cut apart first: p0's component is then a
     // manifold through its vertices as well as its edges.
+    observe(Progress::at(
+        Stage::Validating,
+        mesh.vertices.len(),
+        curves,
+        mesh.triangles.len(),
+    ));
     triangulate::unpinch(&mut mesh.triangles);
     triangulate::keep_main_component(&mut mesh);
     let mut validation = mesh.validate();

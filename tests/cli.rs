@@ -113,6 +113,73 @@ fn bad_input_exits_2_with_a_one_line_message() {
 }
 
 #[test]
+fn each_error_is_printed_once() {
+    let dir = scratch("once");
+    let good = dir.join("good.toml");
+    std::fs::write(
+        &good,
+        "invariant = [1, 4, 16, 0, 0, 0]\n[mesh]\np0 = [0.0, 0.0, 0.25]\ndt = 0.05\n",
+    )
+    .unwrap();
+    let bad = dir.join("bad.toml");
+    std::fs::write(
+        &bad,
+        "invariant = [1, 1, 1, 0, 0, 0]\n[mesh]\nmethod = \"fast\"\n",
+    )
+    .unwrap();
+    // The message names the unknown value; it must show once in stdout and stderr together.
+    let once = |o: &std::process::Output| {
+        let (out, err) = (
+            String::from_utf8_lossy(&o.stdout),
+            String::from_utf8_lossy(&o.stderr),
+        );
+        let n = out.matches("`previous`").count() + err.matches("`previous`").count();
+        assert_eq!(n, 1, "stdout:\n{out}\nstderr:\n{err}");
+        (out.into_owned(), err.into_owned())
+    };
+
+    let o = liemesh()
+        .arg("batch")
+        .args([&good, &bad])
+        .arg("-o")
+        .arg(dir.join("out"))
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(2));
+    let (out, err) = once(&o);
+    // The table marks the input; standard error says what was wrong with it.
+    let row = out.lines().find(|l| l.contains("bad.toml")).unwrap();
+    assert!(row.trim_end().ends_with("FAILED"), "{out}");
+    assert!(out.contains("1 meshed, 1 failed"), "{out}");
+    assert_eq!(err.trim().lines().count(), 1, "{err}");
+    assert!(err.contains("bad.toml") && err.contains("fast"), "{err}");
+
+    // --quiet keeps the errors.
+    let o = liemesh()
+        .args(["batch", "--quiet"])
+        .arg(&bad)
+        .arg("-o")
+        .arg(dir.join("out"))
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(2));
+    let (out, _) = once(&o);
+    assert!(out.is_empty(), "{out}");
+
+    // The other commands print their error once, on standard error.
+    for command in ["mesh", "audit", "quality"] {
+        let o = liemesh()
+            .args([command, "--invariant"])
+            .arg(&bad)
+            .output()
+            .unwrap();
+        assert_eq!(o.status.code(), Some(2), "{command}");
+        let (out, _) = once(&o);
+        assert!(out.is_empty(), "{command}: {out}");
+    }
+}
+
+#[test]
 fn an_invariant_file_meshes_an_ellipsoid_in_every_format() {
     let dir = scratch("ellipsoid");
     let file = dir.join("ellipsoid.toml");

@@ -1,5 +1,6 @@
 //! `liemesh mesh`.
 
+use super::progress::{grouped, with_progress, Status};
 use super::CliError;
 use clap::Args;
 use liemesh::io::invariant_file::InvariantFile;
@@ -338,12 +339,17 @@ fn mesh_in<T: Scalar>(
     invariant: &Invariant,
     params: &MeshParams,
     measure: bool,
+    status: &Status,
 ) -> Result<MeshOutcome, MeshError> {
     let field = LieField::<T>::new(invariant);
     let start = Instant::now();
-    let run = liemesh::run(&field, params)?;
+    let run = liemesh::run_observed(&field, params, &|p| status.report(p))?;
     let seconds = start.elapsed().as_secs_f64();
     let quality = measure.then(|| {
+        status.step(format!(
+            "measuring the quality of {} triangles",
+            grouped(run.mesh.triangles.len())
+        ));
         liemesh::quality::QualityReport::measure(invariant, params, &run.samples, &run.mesh)
     });
     let cut_short = run.cut_short();
@@ -363,21 +369,22 @@ fn mesh_in<T: Scalar>(
 }
 
 /// Meshes `invariant` with `params` in the scalar type `scalar`; with `measure`, also
-/// measures the mesh's quality.
+/// measures the mesh's quality. What it is doing goes to `status`.
 pub fn mesh_invariant(
     invariant: &Invariant,
     params: &MeshParams,
     scalar: ScalarKind,
     measure: bool,
+    status: &Status,
 ) -> Result<MeshOutcome, CliError> {
     Ok(match scalar {
-        ScalarKind::F32 => mesh_in::<f32>(invariant, params, measure)?,
-        ScalarKind::F64 => mesh_in::<f64>(invariant, params, measure)?,
-        ScalarKind::Dual => mesh_in::<Dual<f64>>(invariant, params, measure)?,
+        ScalarKind::F32 => mesh_in::<f32>(invariant, params, measure, status)?,
+        ScalarKind::F64 => mesh_in::<f64>(invariant, params, measure, status)?,
+        ScalarKind::Dual => mesh_in::<Dual<f64>>(invariant, params, measure, status)?,
         ScalarKind::Mpfr => {
             #[cfg(feature = "mpfr")]
             {
-                mesh_in::<liemesh::scalar::Mpfr<256>>(invariant, params, measure)?
+                mesh_in::<liemesh::scalar::Mpfr<256>>(invariant, params, measure, status)?
             }
             #[cfg(not(feature = "mpfr"))]
             {
@@ -396,22 +403,20 @@ pub(super) fn run(args: &MeshArgs) -> Result<ExitCode, CliError> {
         io::MeshFormat::from_path(out)?;
     }
     let scalar = ScalarKind::from(args.scalar);
-    let label = preset.map_or("invariant", |p| p.name());
-    let outcome = with_spinner(&format!("meshing {label} in {scalar}"), args.quiet, || {
-        mesh_invariant(
-            &invariant,
-            &params,
-            scalar,
-            args.report.is_some() || args.json,
-        )
+    let measure = args.report.is_some() || args.json;
+    let (outcome, derivatives) = with_progress(args.quiet, |status| {
+        let outcome = mesh_invariant(&invariant, &params, scalar, measure, status)?;
+        let derivatives = derivatives(args, &invariant, &params, &outcome.mesh, status)?;
+        if let Some(out) = &args.output {
+            status.step(format!("writing {}", out.display()));
+            write_mesh_with(args, out, &outcome.mesh, &derivatives)?;
+        }
+        if let Some(png) = &args.png {
+            status.step(format!("drawing {}", png.display()));
+            super::picture::render_to_file(&outcome.mesh, png, &args.picture.options())?;
+        }
+        Ok::<_, CliError>((outcome, derivatives))
     })?;
-    let derivatives = derivatives(args, &invariant, &params, &outcome.mesh)?;
-    if let Some(out) = &args.output {
-        write_mesh_with(args, out, &outcome.mesh, &derivatives)?;
-    }
-    if let Some(png) = &args.png {
-        super::picture::render_to_file(&outcome.mesh, png, &args.picture.options())?;
-    }
     let mut report = Report::new(
         preset.map(|p| p.name().to_string()),
         &invariant,
@@ -444,6 +449,7 @@ fn derivatives(
     invariant: &Invariant,
     params: &MeshParams,
     mesh: &Mesh,
+    status: &Status,
 ) -> Result<Vec<VertexDerivatives>, CliError> {
     if args.derivative.is_empty() {
         return Ok(Vec::new());
@@ -472,6 +478,7 @@ fn derivatives(
         }
         // The 6 numbers of a linear invariant are the first row of the 18-number layout.
         let index = number - 1;
+        status.step(format!("differentiating by invariant number {number}"));
         let d = liemesh::differentiate(&LieField::<f64>::seeded(invariant, index), params)?;
         if d.mesh.vertices != mesh.vertices || d.mesh.triangles != mesh.triangles {
             return Err(CliError::Usage(format!(
@@ -537,32 +544,6 @@ fn write_mesh_with(
         })
     };
     Ok(write()?)
-}
-
-/// Runs `work`; if it takes longer than a second and standard error is a terminal, shows a
-/// spinner with `message` until it is done (nothing at all when not a terminal or `quiet`).
-pub(super) fn with_spinner<R>(message: &str, quiet: bool, work: impl FnOnce() -> R) -> R {
-    use std::io::IsTerminal;
-    use std::sync::mpsc;
-    use std::time::Duration;
-    if quiet || !std::io::stderr().is_terminal() {
-        return work();
-    }
-    let (done, finished) = mpsc::channel::<()>();
-    let message = message.to_string();
-    let spinner = std::thread::spawn(move || {
-        if finished.recv_timeout(Duration::from_secs(1)).is_ok() {
-            return;
-        }
-        let bar = indicatif::ProgressBar::new_spinner().with_message(message);
-        bar.enable_steady_tick(Duration::from_millis(100));
-        let _ = finished.recv();
-        bar.finish_and_clear();
-    });
-    let result = work();
-    let _ = done.send(());
-    let _ = spinner.join();
-    result
 }
 
 pub(super) fn write_json<S: serde::Serialize>(path: &Path, value: &S) -> Result<(), CliError> {

@@ -11,6 +11,7 @@ mod bench;
 mod mesh;
 mod paper;
 mod picture;
+mod progress;
 mod quality;
 mod render;
 mod workloads;

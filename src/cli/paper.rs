@@ -95,6 +95,7 @@ pub fn reproduce(dir: &std::path::Path) -> Result<Vec<PaperRow>, CliError> {
             &preset.params(),
             ScalarKind::F64,
             false,
+            &super::progress::Status::default(),
         )?;
         let mesh = &outcome.mesh;
         io::write_mesh(

@@ -20,6 +20,11 @@
 //! used by any triangle count too, so a selection of triangles over the same
 //! vertex list is framed exactly like the whole mesh.
 //!
+//! Edges shorter on the picture than a few pixels are faded and, below
+//! [`EDGE_HIDDEN_BELOW`], left out (see [`EDGE_FULL_FROM`]): a mesh of a
+//! hundred thousand triangles reads by its shading instead of turning black
+//! under its edges, and a small mesh keeps all of its edges.
+//!
 //! Output is deterministic: faces at equal depth are drawn in index order,
 //! and the same mesh and options give byte-identical files.
 //!
@@ -50,6 +55,21 @@ pub const MIN_ANGLE_RAMP_MAX_DEGREES: f64 = 60.0;
 /// Angle between vertex normals, in degrees, at the top of the
 /// [`ColorBy::EdgeNormalAngle`] colour ramp; larger angles get the same colour.
 pub const EDGE_NORMAL_ANGLE_RAMP_MAX_DEGREES: f64 = 30.0;
+
+/// Edges whose projection is at most this many line widths long (or pixels, for lines up
+/// to a pixel wide) are not drawn: the faces' shading shows the surface there.
+pub const EDGE_HIDDEN_BELOW: f32 = 2.0;
+
+/// Edges whose projection is at least this many line widths (or pixels) long are drawn in
+/// full; between [`EDGE_HIDDEN_BELOW`] and this, their opacity grows with their length.
+///
+/// Edges of length `L` cover about `3.5 w / L` of a mesh of equilateral faces drawn with
+/// lines `w` wide: drawn in full, a mesh of 4-pixel faces would be nearly black. Faded in
+/// proportion, the lines darken the faces by at most about a third at any density.
+pub const EDGE_FULL_FROM: f32 = 10.0;
+
+/// Opacity steps of faded edges (edges of one colour and opacity are drawn together).
+const FADE_STEPS: f32 = 16.0;
 
 /// Where the camera stands and how it projects.
 ///
@@ -277,7 +297,8 @@ pub enum RenderError {
 /// The image is RGB if the background is opaque and RGBA otherwise, and is
 /// compressed for speed rather than size. Faces are filled, and each edge is
 /// stroked once, after the fills of both its faces and before anything that
-/// lies in front of it. Faces are filled without anti-aliasing when opaque
+/// lies in front of it, fainter the shorter it is on the picture (see
+/// [`EDGE_FULL_FROM`]). Faces are filled without anti-aliasing when opaque
 /// edges at least a pixel wide cover their borders (this also avoids faint
 /// seams between neighbouring faces), and with it otherwise.
 ///
@@ -477,6 +498,9 @@ fn encode_png(pixmap: Pixmap, opaque: bool) -> Result<Vec<u8>, RenderError> {
 /// triangle in back-to-front order, each stroked with the edge colour. With
 /// [`ColorBy::EdgeNormalAngle`] the polygons are not stroked; instead each
 /// edge is one `<line>`, placed after the last polygon containing it.
+/// Small faces are outlined fainter (by their mean edge length on the
+/// picture, as [`render_png`] fades each edge by its length) and the smallest
+/// not at all; lines too short to draw are left out.
 /// Coordinates are written with two decimals.
 ///
 /// # Errors
@@ -529,18 +553,29 @@ pub fn render_svg(mesh: &Mesh, options: &RenderOptions) -> Result<String, Render
         if per_edge && draw_edges {
             // The edges follow as separately coloured lines.
             polygon = polygon.set("stroke", "none");
+        } else if draw_edges && face.outline_fade == 0.0 {
+            // Too small on the picture to outline: its shading shows it.
+            polygon = polygon.set("stroke", "none");
+        } else if draw_edges && face.outline_fade < 1.0 {
+            // Both faces of an edge outline it: each at the opacity that, laid
+            // twice, gives the faded edge's.
+            let alpha = f32::from(faded(options.edge_color[3], face.outline_fade)) / 255.0;
+            let once = 1.0 - (1.0 - alpha).sqrt();
+            polygon = polygon.set("stroke-opacity", format!("{once:.3}"));
         }
         group = group.add(polygon);
         if per_edge && draw_edges {
-            for ([r, g, b, _], [p, q]) in face.drawn_edges() {
-                group = group.add(
-                    Line::new()
-                        .set("x1", format!("{:.2}", p[0]))
-                        .set("y1", format!("{:.2}", p[1]))
-                        .set("x2", format!("{:.2}", q[0]))
-                        .set("y2", format!("{:.2}", q[1]))
-                        .set("stroke", hex([r, g, b])),
-                );
+            for ([r, g, b, a], [p, q]) in face.drawn_edges() {
+                let mut line = Line::new()
+                    .set("x1", format!("{:.2}", p[0]))
+                    .set("y1", format!("{:.2}", p[1]))
+                    .set("x2", format!("{:.2}", q[0]))
+                    .set("y2", format!("{:.2}", q[1]))
+                    .set("stroke", hex([r, g, b]));
+                if a < 255 {
+                    line = line.set("stroke-opacity", opacity(a));
+                }
+                group = group.add(line);
             }
         }
     }
@@ -596,8 +631,12 @@ struct Face {
     triangle: usize,
     points: [[f32; 2]; 3],
     fill: [u8; 3],
-    /// RGBA colours of the edges `points[k] → points[k + 1]`.
+    /// RGBA colours of the edges `points[k] → points[k + 1]`, their alpha
+    /// already faded by the edge's length on the picture (0: not drawn).
     edge_colors: [[u8; 4]; 3],
+    /// Opacity factor of the outline of the face as a whole (SVG polygons),
+    /// from its mean edge length on the picture.
+    outline_fade: f32,
     /// Whether edge `k` is drawn with this face. Each edge is drawn once,
     /// with the last face containing it in drawing order: by then the fills
     /// of all its faces are down, and anything drawn later is nearer the
@@ -612,10 +651,11 @@ impl Face {
         [[a, b], [b, c], [c, a]]
     }
 
-    /// The edges drawn with this face, with their colours.
+    /// The edges drawn with this face, with their colours (edges faded out
+    /// entirely are left out).
     fn drawn_edges(&self) -> impl Iterator<Item = ([u8; 4], [[f32; 2]; 2])> + '_ {
         (0..3)
-            .filter(|&k| self.owned[k])
+            .filter(|&k| self.owned[k] && self.edge_colors[k][3] > 0)
             .map(|k| (self.edge_colors[k], self.edges()[k]))
     }
 }
@@ -937,11 +977,21 @@ impl Scene {
                     }),
                     ColorBy::None | ColorBy::MinAngle => [options.edge_color; 3],
                 };
+                let lengths = [0, 1, 2].map(|k| {
+                    let (p, q) = (points[k], points[(k + 1) % 3]);
+                    (p[0] - q[0]).hypot(p[1] - q[1])
+                });
+                let mut edge_colors = edge_colors;
+                for (color, &length) in edge_colors.iter_mut().zip(&lengths) {
+                    color[3] = faded(color[3], edge_fade(length, options.line_width));
+                }
+                let mean = (lengths[0] + lengths[1] + lengths[2]) / 3.0;
                 Face {
                     triangle: i,
                     points,
                     fill,
                     edge_colors,
+                    outline_fade: edge_fade(mean, options.line_width),
                     owned: [true; 3],
                 }
             })
@@ -970,6 +1020,24 @@ impl Scene {
         }
         Ok(Scene { faces })
     }
+}
+
+/// The opacity factor of an edge `length` pixels long on the picture, drawn
+/// `line_width` wide: 0 up to [`EDGE_HIDDEN_BELOW`] widths, 1 from
+/// [`EDGE_FULL_FROM`] widths, linear between, in steps of 1/16 (widths under
+/// a pixel count as a pixel). A length that is not a number counts as long.
+fn edge_fade(length: f32, line_width: f32) -> f32 {
+    let unit = line_width.max(1.0);
+    let t = (length / unit - EDGE_HIDDEN_BELOW) / (EDGE_FULL_FROM - EDGE_HIDDEN_BELOW);
+    if t.is_nan() {
+        return 1.0;
+    }
+    (t.clamp(0.0, 1.0) * FADE_STEPS).round() / FADE_STEPS
+}
+
+/// `alpha` times `fade`, rounded.
+fn faded(alpha: u8, fade: f32) -> u8 {
+    (f32::from(alpha) * fade).round() as u8
 }
 
 /// Smallest interior angle of the triangle `abc` in radians (0 if degenerate).
@@ -1215,6 +1283,77 @@ mod tests {
                 assert_ne!(p, white, "pixel ({x}, {y}) at radius {r:.1}");
             }
         }
+    }
+
+    #[test]
+    fn dense_meshes_read_by_their_shading() {
+        // 131,072 triangles in a disc of radius 0.45 · 400 = 180 px: about a
+        // pixel and a half of picture per front face. Drawing every edge in
+        // the edge colour (luma 30) would make the disc nearly black.
+        let mesh = icosphere(7);
+        assert_eq!(mesh.triangles.len(), 131_072);
+        let options = RenderOptions {
+            width: 400,
+            height: 400,
+            ..RenderOptions::default()
+        };
+        let pixmap = Pixmap::decode_png(&render_png(&mesh, &options).unwrap()).unwrap();
+        let (mut sum, mut count) = (0, 0);
+        for y in 0..400 {
+            for x in 0..400 {
+                if (f64::from(x) - 199.5).hypot(f64::from(y) - 199.5) < 150.0 {
+                    sum += luma(rgba(&pixmap, x, y));
+                    count += 1;
+                }
+            }
+        }
+        let mean = sum / count;
+        assert!(mean > 150, "mean luma inside the disc: {mean}");
+
+        // The SVG leaves the outlines of faces that small out.
+        let svg = render_svg(&mesh, &options).unwrap();
+        let bare = svg.matches(r#"stroke="none""#).count();
+        assert!(
+            bare > mesh.triangles.len() / 2,
+            "{bare} faces without outline"
+        );
+
+        // A coarse mesh keeps every edge in full, in both formats.
+        let coarse = icosphere(2);
+        let scene = Scene::new(&coarse, &options).unwrap();
+        assert!(scene
+            .faces
+            .iter()
+            .all(|f| f.outline_fade == 1.0 && f.edge_colors.iter().all(|c| c[3] == 255)));
+        let svg = render_svg(&coarse, &options).unwrap();
+        assert!(!svg.contains(r#"stroke="none""#) && !svg.contains("stroke-opacity"));
+    }
+
+    #[test]
+    fn edges_fade_with_their_length_on_the_picture() {
+        assert_eq!(edge_fade(0.0, 1.0), 0.0);
+        assert_eq!(edge_fade(EDGE_HIDDEN_BELOW, 1.0), 0.0);
+        assert_eq!(
+            edge_fade(0.5 * (EDGE_HIDDEN_BELOW + EDGE_FULL_FROM), 1.0),
+            0.5
+        );
+        assert_eq!(edge_fade(EDGE_FULL_FROM, 1.0), 1.0);
+        assert_eq!(edge_fade(1e6, 1.0), 1.0);
+        assert_eq!(edge_fade(f32::NAN, 1.0), 1.0);
+        // Hairlines count as a pixel wide; wider lines need longer edges.
+        assert_eq!(edge_fade(EDGE_FULL_FROM, 0.25), 1.0);
+        assert_eq!(edge_fade(3.0 * EDGE_HIDDEN_BELOW, 3.0), 0.0);
+        assert!(edge_fade(EDGE_FULL_FROM, 3.0) < 0.5);
+        assert_eq!(edge_fade(3.0 * EDGE_FULL_FROM, 3.0), 1.0);
+        // Monotone, in steps of 1/16.
+        let mut last = 0.0;
+        for i in 0..200 {
+            let f = edge_fade(i as f32 * 0.1, 1.0);
+            assert!(f >= last && (f * 16.0).fract() == 0.0, "{i}: {f}");
+            last = f;
+        }
+        assert_eq!(faded(255, 0.5), 128);
+        assert_eq!(faded(200, 0.0), 0);
     }
 
     #[test]

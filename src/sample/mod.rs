@@ -14,6 +14,7 @@ use crate::error::MeshError;
 use crate::geom::vec3::{dist, dot, sub};
 use crate::mesh::Provenance;
 use crate::params::{MeshParams, Method, Mode, Resolved};
+use crate::progress::{Progress, Stage, SAMPLING_REPORT_EVERY};
 use crate::scalar::{Scalar, Vec3};
 use crate::trace::{self, StepConfig, StepLimit};
 use crate::NormalField;
@@ -203,13 +204,14 @@ pub fn sample<T: Scalar, F: NormalField<T>>(
     field: &F,
     params: &MeshParams,
 ) -> Result<Samples<T>, MeshError> {
-    sample_resolved(field, &params.resolve::<T, F>(field)?)
+    sample_resolved(field, &params.resolve::<T, F>(field)?, &|_| {})
 }
 
-/// [`sample`] with the parameters already resolved.
+/// [`sample`] with the parameters already resolved, reporting its progress to `observe`.
 pub(crate) fn sample_resolved<T: Scalar, F: NormalField<T>>(
     field: &F,
     params: &Resolved,
+    observe: &dyn Fn(Progress),
 ) -> Result<Samples<T>, MeshError> {
     let cfg = StepConfig::<T>::new(params);
     let p0 = Vec3::<T>::from_f64(params.p0);
@@ -266,6 +268,7 @@ pub(crate) fn sample_resolved<T: Scalar, F: NormalField<T>>(
         grid: Grid::new(params.dt.max(1e-300)),
         drift: Vec::new(),
         max_drift: 0.0,
+        observe,
     };
     if params.mode == Mode::Paper {
         s.drift.push(0.0);
@@ -332,6 +335,8 @@ struct Sampler<'a, T, F> {
     drift: Vec<f64>,
     /// The largest entry of `drift`.
     max_drift: f64,
+    /// Where progress is reported (every [`SAMPLING_REPORT_EVERY`] passes of [`Self::run`]).
+    observe: &'a dyn Fn(Progress),
 }
 
 impl<T: Scalar, F: NormalField<T>> Sampler<'_, T, F> {
@@ -345,7 +350,11 @@ impl<T: Scalar, F: NormalField<T>> Sampler<'_, T, F> {
         // Every pass either adds a point or ends a curve, so this bound is never the binding
         // one; it is here so that the loop visibly terminates.
         let max_passes = budget.max_points + 2 * budget.max_curves + 16;
-        for _ in 0..max_passes {
+        for pass in 0..max_passes {
+            if pass % SAMPLING_REPORT_EVERY == 0 {
+                let (points, curves) = (self.out.points.len(), self.out.curves.len());
+                (self.observe)(Progress::at(Stage::Sampling, points, curves, 0));
+            }
             let Some(Reverse((_, c))) = self.heap.pop() else {
                 return;
             };

@@ -87,13 +87,15 @@ pub(crate) fn faces_over<T: Scalar, F: NormalField<T>>(
 /// Splits the faces of `mesh` whose normal error exceeds `limit_deg` until none does, or the
 /// rounds or `params.max_points` run out. `pos` holds the vertices in the working
 /// precision and grows with the mesh. A mesh that is not a consistently oriented 2-manifold
-/// is left as it is.
+/// is left as it is. `on_round(round, vertices, triangles)` is called as each round starts
+/// (rounds counting from 1), for progress reports.
 pub(crate) fn refine<T: Scalar, F: NormalField<T>>(
     field: &F,
     params: &Resolved,
     limit_deg: f64,
     mesh: &mut Mesh,
     pos: &mut Vec<Vec3<T>>,
+    on_round: &dyn Fn(usize, usize, usize),
 ) -> Refinement {
     let cfg = StepConfig::<T>::new(params);
     // The error is measured on the `f64` mesh, as the quality report measures it; a field in
@@ -137,6 +139,7 @@ pub(crate) fn refine<T: Scalar, F: NormalField<T>>(
         if done.over_limit == 0 || vertices.len() >= params.max_points {
             break;
         }
+        on_round(round + 1, vertices.len(), he.triangles().len());
         let mut bad: Vec<u32> = (0..errors.len() as u32)
             .filter(|&t| errors[t as usize] > limit_deg)
             .collect();
