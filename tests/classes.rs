@@ -5,15 +5,15 @@
 //! | class | what every mesh must be |
 //! |---|---|
 //! | ellipsoids (any scale, any axis order, any pose) | valid, closed, χ = 2 |
-//! | elliptic cylinders along any axis, in any pose | valid; a band (χ = 0, two boundary loops) in at least 85% of cases |
-//! | hyperboloids of one sheet, in any pose | valid; a band (χ = 0, two boundary loops) in at least 85% of cases |
+//! | elliptic cylinders along any axis, in any pose | valid; a band (χ = 0, two boundary loops) in at least 95% of cases |
+//! | hyperboloids of one sheet, in any pose | valid; a band (χ = 0, two boundary loops) in at least 95% of cases |
 //! | hyperboloids of two sheets, in any pose | valid, one sheet: a disc |
-//! | cones, in any pose | valid; one nappe (χ = 1 with one loop, or χ = 0 with two: meeting at or stopping short of the apex) in at least 85% of cases |
+//! | cones, in any pose | valid; one nappe (χ = 1 with one loop, or χ = 0 with two: meeting at or stopping short of the apex) in at least 95% of cases |
 //! | linear invariants with non-zero angles (non-integrable) | valid, at least 200 triangles; at most a fifth `MeshError::Empty` |
 //! | 18-number Hamiltonian invariants, entries in [−1, 1] | valid, at least 200 triangles |
 //! | 12-number Hamiltonian invariants with diagonal `A` (cubics) | valid, vertices on the level set; at most a fifth `MeshError::Empty` |
-//! | tori (a `FnField`) | valid; closed with χ = 0 in at least 70% of cases |
-//! | tori with an elliptic tube about a tilted axis (a `FnField`) | valid; closed with χ = 0 in at least 70% of cases (ignored: about half close) |
+//! | tori (a `FnField`) | valid; closed with χ = 0 in at least 75% of cases |
+//! | tori with an elliptic tube about a tilted axis (a `FnField`) | valid; closed with χ = 0 in at least 75% of cases (ignored: 14 of 24 close with its seed) |
 //!
 //! "Valid" is [`liemesh::mesh::Validation::is_valid`]: manifold, consistently oriented, no
 //! degenerate face and no self-intersection, decided exactly. The mesher itself refuses to
@@ -40,14 +40,14 @@ const CASES: u32 = 24;
 const HAMILTONIAN_POINTS: usize = 40_000;
 
 /// The share of cylinders, one-sheet hyperboloids and cones (in percent) allowed to come out
-/// valid but with the wrong topology (an extra hole left where fronts met): measured at 0–10%
-/// over random seeds, see docs/status.md. Every mesh must still be valid.
-const BAND_MISSES: u32 = 15;
+/// valid but with the wrong topology (an extra hole left where fronts met): measured at 0, 1
+/// and 0 of 256 cases with these seeds, see docs/status.md. Every mesh must still be valid.
+const BAND_MISSES: u32 = 5;
 
-/// The share of round tori (in percent) allowed to come out valid but not closed (a small
-/// hole left where fronts met, most often on thin tori): measured at 4 of 24 cases, see
+/// The share of round tori (in percent) allowed to come out valid but not closed (most often
+/// an open tube: the ring was not sampled all the way round): measured at 45 of 256 cases, see
 /// docs/status.md.
-const TORUS_MISSES: u32 = 30;
+const TORUS_MISSES: u32 = 25;
 
 fn runner(seed: u64) -> TestRunner {
     let mut config = Config {
@@ -491,8 +491,9 @@ fn on_torus(big: f64, a: f64, b: f64, tilt: f64, u: f64, v: f64) -> [f64; 3] {
 }
 
 /// The largest relative drift `|F − 1|` off a torus: the chord rule is exact for cubic
-/// potentials only, and the torus's is not one (measured: up to about 2·10⁻⁵).
-const TORUS_DRIFT: f64 = 1e-4;
+/// potentials only, and the torus's is not one (measured: up to 1.5·10⁻⁴ over 256 round and
+/// 256 tilted elliptic tori, on thin tubes where the steps are long against the tube).
+const TORUS_DRIFT: f64 = 3e-4;
 
 fn torus_class(seed: u64, elliptic: bool) -> u32 {
     let tau = std::f64::consts::TAU;
@@ -546,7 +547,7 @@ fn tori_close_with_euler_characteristic_zero() {
 }
 
 #[test]
-#[ignore = "open: about half of tilted elliptic tori keep a hole where fronts met; see docs/status.md"]
+#[ignore = "open: 10 of 24 tilted elliptic tori stay open (most as a tube); see docs/status.md"]
 fn tilted_elliptic_tori_close_with_euler_characteristic_zero() {
     tolerating(TORUS_MISSES, || torus_class(0x7052, true));
 }
