@@ -800,10 +800,22 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
     /// corners it shares with them (exact).
     fn meets_nothing(&self, a: u32, b: u32, x: u32) -> bool {
         let t = [b, a, x];
+        let c = corners(&self.pos, t);
+        let (lo, hi) = bounds(&c);
         let mut hit = false;
-        self.faces.near(&corners(&self.pos, t), |f| {
+        self.faces.near(&c, |f| {
             let g = self.tris[f as usize];
-            hit = hit || (g != DEAD && faces_intersect(&self.pos, t, g));
+            if hit || g == DEAD {
+                return;
+            }
+            // Closed triangles whose boxes are apart have no common point: only faces whose
+            // boxes meet this one's go to the exact test (a non-finite corner, which the
+            // exact test answers `false` for, may be rejected here as well).
+            let (glo, ghi) = bounds(&corners(&self.pos, g));
+            if (0..3).any(|k| ghi[k] < lo[k] || glo[k] > hi[k]) {
+                return;
+            }
+            hit = faces_intersect(&self.pos, t, g);
         });
         !hit
     }
@@ -1152,6 +1164,15 @@ fn segment_distance(p: [f64; 3], a: [f64; 3], b: [f64; 3]) -> f64 {
 fn unit(a: [f64; 3]) -> [f64; 3] {
     let l = dot(a, a).sqrt();
     a.map(|x| x / l)
+}
+
+/// The corners' smallest and largest coordinates.
+#[inline]
+fn bounds(c: &[[f64; 3]; 3]) -> ([f64; 3], [f64; 3]) {
+    (
+        [0, 1, 2].map(|k| c[0][k].min(c[1][k]).min(c[2][k])),
+        [0, 1, 2].map(|k| c[0][k].max(c[1][k]).max(c[2][k])),
+    )
 }
 
 fn corners(pos: &[[f64; 3]], t: [u32; 3]) -> [[f64; 3]; 3] {
