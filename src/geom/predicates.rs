@@ -140,7 +140,12 @@ impl Orient for Checked {
         self.orient3d(pl[0], pl[1], pl[2], d)
     }
     fn orient3d(self, a: P3, b: P3, c: P3, d: P3) -> i8 {
-        if a.iter().chain(&b).chain(&c).chain(&d).all(|&x| surely_in_window(x)) {
+        if a.iter()
+            .chain(&b)
+            .chain(&c)
+            .chain(&d)
+            .all(|&x| surely_in_window(x))
+        {
             return InRange.orient3d(a, b, c, d);
         }
         let e = Exponents::of(a.iter().chain(&b).chain(&c).chain(&d).copied());
@@ -543,7 +548,9 @@ mod tests {
                 assert!(Exponents::of([x]).in_window(), "{x:e}");
             }
         }
-        assert!([0.0, 1.0, -0.3, 1e-70, 1e90].into_iter().all(surely_in_window));
+        assert!([0.0, 1.0, -0.3, 1e-70, 1e90]
+            .into_iter()
+            .all(surely_in_window));
     }
 
     /// The filtered side test agrees with the exact orientation, also where the filter

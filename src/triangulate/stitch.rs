@@ -104,6 +104,10 @@ const REDO_ROUNDS: usize = 5;
 /// Holes of at most this many edges are opened and stitched again.
 const REDO_HOLE: usize = 48;
 
+/// Above any angle as computed (`atan2` of a non-negative `y` is at most π): bounds the part
+/// of a score after its glue.
+const MAX_MIN_ANGLE: f64 = 3.5;
+
 /// The candidate vertex of an edge that is not there yet: the edge's new point.
 const NEW: u32 = u32::MAX;
 
@@ -306,6 +310,8 @@ struct Stitcher<'a, 'f, T, F> {
     rejected: HashSet<(u32, u32, u32), FastHash>,
     version: EdgeMap<u32>,
     heap: BinaryHeap<Candidate>,
+    /// Scratch list of [`Self::refresh`]'s candidates (kept to spare an allocation a call).
+    found: Vec<(f64, u32)>,
 }
 
 impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
@@ -398,6 +404,7 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
             rejected: HashSet::default(),
             version: HashMap::default(),
             heap: BinaryHeap::new(),
+            found: Vec::new(),
         }
     }
 
@@ -451,7 +458,8 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
         let mut best: Option<(f64, u32)> = None;
         // The nearest boundary vertices within reach, a bounded number of them: the work
         // per edge stays constant where boundary vertices crowd.
-        let mut found = Vec::new();
+        let mut found = std::mem::take(&mut self.found);
+        found.clear();
         self.points.near(mid, reach, |x| {
             if x != a && x != b {
                 let d = dist(self.pos[x as usize], mid);
@@ -466,8 +474,14 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
             found.truncate(MAX_CANDIDATES);
         }
         found.sort_unstable_by(order);
-        for (_, x) in found {
+        for &(_, x) in &found {
             if !self.on_boundary(x) || self.rejected.contains(&(a, b, x)) {
+                continue;
+            }
+            // A score is 4 per glued edge plus the smallest angle (below 3.5): a candidate
+            // with less glue than the best so far cannot beat it (a tie keeps the best) and
+            // is not scored.
+            if best.is_some_and(|(s, _)| 4.0 * f64::from(self.glue(a, b, x)) + MAX_MIN_ANGLE <= s) {
                 continue;
             }
             if let Some(score) = self.score(a, b, x, reach, MIN_ANGLE_DEG.to_radians()) {
@@ -476,6 +490,7 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
                 }
             }
         }
+        self.found = found;
         // A new point in front of the edge, if no existing vertex makes a good enough
         // triangle there.
         if best.is_none_or(|(s, _)| s < NEW_POINT_SCORE)
@@ -686,20 +701,24 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
             }
         }
         let (ff, gg) = (dot(face, face), dot(field, field));
-        let angles = angles([pa, pb, px]);
-        let min_angle = angles[0].min(angles[1]).min(angles[2]);
-        // A hole's last sliver (a corner almost on the opposite edge) has no normal to speak
-        // of: it goes in whichever way it faces, and the flips that follow remove it.
-        let sliver = min_floor == 0.0 && min_angle < SLIVER_DEG.to_radians();
         // Against each corner's normal, not only their sum: corners on opposite sides of a
         // thin tube sum to almost nothing, and a triangle across the tube must not pass.
         let cos_tilt = MAX_TILT_DEG.to_radians().cos();
         let tilted = [self.nrm[a as usize], self.nrm[b as usize], nx]
             .iter()
             .any(|n| dot(face, *n) < cos_tilt * (ff * dot(*n, *n)).sqrt());
-        if !(ff > 0.0 && gg > 0.0)
-            || (!sliver && (dot(face, field) < cos_tilt * (ff * gg).sqrt() || tilted))
-        {
+        let leans = dot(face, field) < cos_tilt * (ff * gg).sqrt() || tilted;
+        // With a floor on the angles no triangle is a sliver (below): the facing test comes
+        // before the angles, which are dearer.
+        if !(ff > 0.0 && gg > 0.0) || (min_floor != 0.0 && leans) {
+            return None;
+        }
+        let angles = angles([pa, pb, px]);
+        let min_angle = angles[0].min(angles[1]).min(angles[2]);
+        // A hole's last sliver (a corner almost on the opposite edge) has no normal to speak
+        // of: it goes in whichever way it faces, and the flips that follow remove it.
+        let sliver = min_floor == 0.0 && min_angle < SLIVER_DEG.to_radians();
+        if !sliver && leans {
             return None;
         }
         // Corners where both of the triangle's edges are boundary edges now: there it fills
@@ -725,8 +744,13 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
         {
             return None;
         }
-        let glue = u8::from(self.is_boundary_edge(x, a)) + u8::from(self.is_boundary_edge(b, x));
-        Some(4.0 * f64::from(glue) + min_angle)
+        Some(4.0 * f64::from(self.glue(a, b, x)) + min_angle)
+    }
+
+    /// How many of triangle `(b, a, x)`'s other edges close a boundary edge (its score's
+    /// integer part, times 4).
+    fn glue(&self, a: u32, b: u32, x: u32) -> u8 {
+        u8::from(self.is_boundary_edge(x, a)) + u8::from(self.is_boundary_edge(b, x))
     }
 
     /// Whether the wedge at boundary vertex `v` from the direction of `from` counter-clockwise
