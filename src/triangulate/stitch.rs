@@ -1273,6 +1273,7 @@ fn pinched_fans(triangles: &[[u32; 3]], candidate: impl Fn(u32) -> bool) -> (Vec
     }
     let (mut pinched, mut drop) = (Vec::new(), Vec::new());
     let mut group: Vec<usize> = Vec::new();
+    let (mut roots, mut sizes): (Vec<usize>, Vec<(usize, usize)>) = (Vec::new(), Vec::new());
     for v in 0..n {
         let faces = &star[start[v] as usize..start[v + 1] as usize];
         if faces.len() < 2 {
@@ -1288,7 +1289,9 @@ fn pinched_fans(triangles: &[[u32; 3]], candidate: impl Fn(u32) -> bool) -> (Vec
             }
             i
         }
-        for i in 0..faces.len() {
+        // Once every triangle is in one fan (the usual case) there is nothing to find.
+        let mut fans = faces.len();
+        'pairs: for i in 0..faces.len() {
             let ti = triangles[faces[i] as usize];
             for j in i + 1..faces.len() {
                 let tj = triangles[faces[j] as usize];
@@ -1300,12 +1303,20 @@ fn pinched_fans(triangles: &[[u32; 3]], candidate: impl Fn(u32) -> bool) -> (Vec
                     let (a, b) = (root(&mut group, i), root(&mut group, j));
                     if a != b {
                         group[a.max(b)] = a.min(b);
+                        fans -= 1;
+                        if fans == 1 {
+                            break 'pairs;
+                        }
                     }
                 }
             }
         }
-        let roots: Vec<usize> = (0..faces.len()).map(|i| root(&mut group, i)).collect();
-        let mut sizes: Vec<(usize, usize)> = Vec::new();
+        if fans == 1 {
+            continue;
+        }
+        roots.clear();
+        roots.extend((0..faces.len()).map(|i| root(&mut group, i)));
+        sizes.clear();
         for &r in &roots {
             match sizes.iter_mut().find(|(g, _)| *g == r) {
                 Some(e) => e.1 += 1,
