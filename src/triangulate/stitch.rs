@@ -312,6 +312,11 @@ struct Stitcher<'a, 'f, T, F> {
     heap: BinaryHeap<Candidate>,
     /// Scratch list of [`Self::refresh`]'s candidates (kept to spare an allocation a call).
     found: Vec<(f64, u32)>,
+    /// Whether [`Self::in_open_wedge`] remembers its angles in `wedge_angles` (only during a
+    /// [`Self::refresh`], when no vertex moves or comes and goes).
+    wedge_memo: std::cell::Cell<bool>,
+    /// The angle of vertex `w` about vertex `v` in `v`'s tangent frame, by `(v, w)`.
+    wedge_angles: std::cell::RefCell<HashMap<(u32, u32), f64, FastHash>>,
 }
 
 impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
@@ -405,6 +410,8 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
             version: HashMap::default(),
             heap: BinaryHeap::new(),
             found: Vec::new(),
+            wedge_memo: std::cell::Cell::new(false),
+            wedge_angles: std::cell::RefCell::new(HashMap::default()),
         }
     }
 
@@ -458,6 +465,8 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
         let mut best: Option<(f64, u32)> = None;
         // The nearest boundary vertices within reach, a bounded number of them: the work
         // per edge stays constant where boundary vertices crowd.
+        self.wedge_angles.get_mut().clear();
+        self.wedge_memo.set(true);
         let mut found = std::mem::take(&mut self.found);
         found.clear();
         self.points.near(mid, reach, |x| {
@@ -491,6 +500,7 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
             }
         }
         self.found = found;
+        self.wedge_memo.set(false);
         // A new point in front of the edge, if no existing vertex makes a good enough
         // triangle there.
         if best.is_none_or(|(s, _)| s < NEW_POINT_SCORE)
@@ -736,11 +746,11 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
         // wedge yet). A hole's last triangles are ears of its loop: the exact test alone
         // decides those.
         if min_floor > 0.0
-            && !(self.in_open_wedge(a, px, pb)
-                && self.in_open_wedge(b, pa, px)
+            && !(self.in_open_wedge(a, x, b)
+                && self.in_open_wedge(b, a, x)
                 && (self.prov[x as usize].curve == Provenance::CLOSING_CURVE
                     && !self.on_boundary(x)
-                    || self.in_open_wedge(x, pb, pa)))
+                    || self.in_open_wedge(x, b, a)))
         {
             return None;
         }
@@ -757,7 +767,10 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
     /// to that of `to` (about `v`'s field normal) lies in one of `v`'s open wedges: from a
     /// boundary in-edge's source counter-clockwise to a boundary out-edge's target, with no
     /// other boundary edge of `v` between.
-    fn in_open_wedge(&self, v: u32, from: [f64; 3], to: [f64; 3]) -> bool {
+    ///
+    /// During [`Self::refresh`] the angles about `v` are remembered (its candidates share
+    /// their edge's ends and the ends' boundary neighbours): the same value as computed anew.
+    fn in_open_wedge(&self, v: u32, from: u32, to: u32) -> bool {
         let (Some(outs), Some(ins)) = (self.bout.get(&v), self.bin.get(&v)) else {
             return false;
         };
@@ -771,17 +784,27 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
         };
         let e1 = unit(cross(helper, n));
         let e2 = cross(n, e1);
-        let angle = |q: [f64; 3]| {
-            let d = sub(q, p);
-            dot(d, e2).atan2(dot(d, e1))
+        let memo = self.wedge_memo.get();
+        let angle = |w: u32| {
+            if memo {
+                if let Some(&t) = self.wedge_angles.borrow().get(&(v, w)) {
+                    return t;
+                }
+            }
+            let d = sub(self.pos[w as usize], p);
+            let t = dot(d, e2).atan2(dot(d, e1));
+            if memo {
+                self.wedge_angles.borrow_mut().insert((v, w), t);
+            }
+            t
         };
         let ccw = |from: f64, to: f64| (to - from).rem_euclid(std::f64::consts::TAU);
         let (af, at) = (angle(from), angle(to));
         let span = ccw(af, at);
         for &z in ins {
-            let az = angle(self.pos[z as usize]);
+            let az = angle(z);
             for &y in outs {
-                let ay = angle(self.pos[y as usize]);
+                let ay = angle(y);
                 let wedge = ccw(az, ay);
                 // The triangle's span must lie inside the wedge…
                 if !(ccw(az, af) <= wedge && ccw(az, af) + span <= wedge + 1e-12) {
@@ -790,7 +813,7 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
                 // …and no other boundary edge of v may cut the wedge.
                 let cut = outs.iter().chain(ins.iter()).any(|&u| {
                     u != z && u != y && {
-                        let au = ccw(az, angle(self.pos[u as usize]));
+                        let au = ccw(az, angle(u));
                         au > 0.0 && au < wedge
                     }
                 });
