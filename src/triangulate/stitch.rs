@@ -317,6 +317,12 @@ struct Stitcher<'a, 'f, T, F> {
     wedge_memo: std::cell::Cell<bool>,
     /// The angle of vertex `w` about vertex `v` in `v`'s tangent frame, by `(v, w)`.
     wedge_angles: std::cell::RefCell<HashMap<(u32, u32), f64, FastHash>>,
+    /// A count per vertex of the changes to the edges and boundary edges at it (see
+    /// [`Self::touch`]).
+    epoch: Vec<u32>,
+    /// [`Self::refresh`]'s scores by candidate `(a, b, x)`, with the epochs of `a`, `b`, `x`
+    /// and the bits of the reach they were computed for.
+    scores: HashMap<(u32, u32, u32), ([u32; 3], u64, Option<f64>), FastHash>,
 }
 
 impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
@@ -412,6 +418,8 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
             found: Vec::new(),
             wedge_memo: std::cell::Cell::new(false),
             wedge_angles: std::cell::RefCell::new(HashMap::default()),
+            epoch: Vec::new(),
+            scores: HashMap::default(),
         }
     }
 
@@ -493,7 +501,7 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
             if best.is_some_and(|(s, _)| 4.0 * f64::from(self.glue(a, b, x)) + MAX_MIN_ANGLE <= s) {
                 continue;
             }
-            if let Some(score) = self.score(a, b, x, reach, MIN_ANGLE_DEG.to_radians()) {
+            if let Some(score) = self.refresh_score(a, b, x, reach) {
                 if best.is_none_or(|(s, _)| score > s) {
                     best = Some((score, x));
                 }
@@ -520,6 +528,37 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
         }
     }
 
+    /// [`Self::score`] with the refresh's angle floor, remembered: a score reads the
+    /// positions, normals and provenance of `a`, `b`, `x` (which do not change once a vertex
+    /// is registered), the reach, and the edges and boundary edges at `a`, `b` and `x` (each
+    /// change to those bumps the vertex's epoch). So a remembered score with the same epochs
+    /// and reach is the score computed anew.
+    fn refresh_score(&mut self, a: u32, b: u32, x: u32, reach: f64) -> Option<f64> {
+        let epochs = [a, b, x].map(|v| self.epoch.get(v as usize).copied().unwrap_or(0));
+        if let Some(&(e, r, score)) = self.scores.get(&(a, b, x)) {
+            if e == epochs && r == reach.to_bits() {
+                return score;
+            }
+        }
+        let score = self.score(a, b, x, reach, MIN_ANGLE_DEG.to_radians());
+        self.scores
+            .insert((a, b, x), (epochs, reach.to_bits(), score));
+        score
+    }
+
+    /// Notes a change at vertex `v` (its edges, its boundary edges, or the vertex itself):
+    /// remembered scores that involve it are stale.
+    fn touch(&mut self, v: u32) {
+        let v = v as usize;
+        if v >= self.epoch.len() {
+            if v > self.pos.len() {
+                return;
+            }
+            self.epoch.resize(v + 1, 0);
+        }
+        self.epoch[v] = self.epoch[v].wrapping_add(1);
+    }
+
     /// Whether edge `a → b` may get a new point in front of it.
     fn may_grow(&self, a: u32, b: u32) -> bool {
         self.growth.new_points
@@ -537,6 +576,7 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
         }
         let p = self.proposals[&(a, b)].clone()?;
         let v = self.pos.len() as u32;
+        self.touch(v);
         self.pos.push(p.pos);
         self.nrm.push(p.normal);
         self.prov.push(Provenance {
@@ -552,6 +592,7 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
 
     /// Takes back the vertex on trial.
     fn retract(&mut self) {
+        self.touch(self.pos.len() as u32 - 1);
         self.pos.pop();
         self.nrm.pop();
         self.prov.pop();
@@ -1120,6 +1161,9 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
     fn remove_triangle(&mut self, f: u32) {
         let t = self.tris[f as usize];
         self.tris[f as usize] = DEAD;
+        for v in t {
+            self.touch(v);
+        }
         for k in 0..3 {
             let (u, v) = (t[k], t[(k + 1) % 3]);
             self.edges.remove(&(u, v));
@@ -1150,6 +1194,9 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
         let f = self.tris.len() as u32;
         self.tris.push(t);
         self.faces.insert(f, corners(&self.pos, t));
+        for v in t {
+            self.touch(v);
+        }
         for k in 0..3 {
             let (u, v) = (t[k], t[(k + 1) % 3]);
             self.edges.insert((u, v), f);
