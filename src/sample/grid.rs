@@ -50,7 +50,7 @@ impl Grid {
 
     #[inline]
     fn key(&self, p: [f64; 3]) -> Cell {
-        let k = |x: f64| (x * self.inv).floor().clamp(-1e9, 1e9) as i32;
+        let k = |x: f64| crate::geom::grid::floor_clamped(x * self.inv);
         (k(p[0]), k(p[1]), k(p[2]))
     }
 

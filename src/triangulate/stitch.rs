@@ -390,7 +390,7 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
         for &v in &boundary {
             points.insert(v, pos[v as usize]);
         }
-        let mut faces = FaceGrid::new(cell);
+        let mut faces = FaceGrid::new(cell, tris.len());
         for (f, t) in tris.iter().enumerate() {
             faces.insert(f as u32, corners(&pos, *t));
         }
@@ -1421,7 +1421,7 @@ struct PointGrid {
 }
 
 fn cell_of(inv: f64, p: [f64; 3]) -> Cell {
-    let k = |x: f64| (x * inv).floor().clamp(-1e9, 1e9) as i32;
+    let k = |x: f64| crate::geom::grid::floor_clamped(x * inv);
     (k(p[0]), k(p[1]), k(p[2]))
 }
 
@@ -1469,10 +1469,11 @@ struct FaceGrid {
 }
 
 impl FaceGrid {
-    fn new(cell: f64) -> Self {
+    /// A grid of cells of side `cell` with room for about `faces` triangles.
+    fn new(cell: f64, faces: usize) -> Self {
         FaceGrid {
             inv: 1.0 / cell,
-            cells: HashMap::default(),
+            cells: HashMap::with_capacity_and_hasher(faces, FastHash::default()),
             large: Vec::new(),
         }
     }
