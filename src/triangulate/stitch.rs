@@ -273,6 +273,9 @@ pub(crate) fn stitch<T: Scalar, F: NormalField<T>>(
     out
 }
 
+/// A remembered score: the epochs of its vertices, the bits of its reach, the score.
+type RememberedScore = ([u32; 3], u64, Option<f64>);
+
 /// A new point proposed for an edge, before it is committed.
 #[derive(Clone)]
 struct Proposal<T> {
@@ -322,7 +325,7 @@ struct Stitcher<'a, 'f, T, F> {
     epoch: Vec<u32>,
     /// [`Self::refresh`]'s scores by candidate `(a, b, x)`, with the epochs of `a`, `b`, `x`
     /// and the bits of the reach they were computed for.
-    scores: HashMap<(u32, u32, u32), ([u32; 3], u64, Option<f64>), FastHash>,
+    scores: HashMap<(u32, u32, u32), RememberedScore, FastHash>,
 }
 
 impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
