@@ -154,6 +154,20 @@ fn cell_of(x: f64, inv: f64) -> i64 {
     }
 }
 
+/// `y.floor().clamp(-1e9, 1e9) as i32` (NaN: 0) without `f64::floor`, a libm call on
+/// baseline x86-64: truncation, one down for negative non-integers (exact below 2⁶³ in
+/// magnitude; beyond, `as` saturates and the clamp decides as before).
+#[inline]
+pub(crate) fn floor_clamped(y: f64) -> i32 {
+    let t = y as i64;
+    let t = if (t as f64) > y {
+        t.saturating_sub(1)
+    } else {
+        t
+    };
+    t.clamp(-1_000_000_000, 1_000_000_000) as i32
+}
+
 /// `x`'s low 21 bits spread to every third bit (Morton interleaving).
 #[inline]
 fn spread3(x: u64) -> u64 {
@@ -809,6 +823,42 @@ mod tests {
         };
         grid.query(&huge, &mut out);
         assert_eq!(out.len(), grid.len());
+    }
+
+    #[test]
+    fn floor_clamped_is_floor_clamp_and_cast() {
+        let mut rng = XorShift64::new(17);
+        let special = [
+            0.0,
+            -0.0,
+            0.5,
+            -0.5,
+            -1.0,
+            2.0,
+            -2.5,
+            4503599627370495.5,
+            -4503599627370495.5,
+            9007199254740993.0,
+            1e9 - 0.5,
+            -1e9 - 0.5,
+            1e9 + 3.0,
+            -1e9 - 3.0,
+            9.3e18,
+            -9.3e18,
+            1e300,
+            -1e300,
+            f64::INFINITY,
+            f64::NEG_INFINITY,
+            f64::NAN,
+            f64::MIN_POSITIVE,
+            -f64::MIN_POSITIVE,
+        ];
+        let mut values = special.to_vec();
+        values.extend((0..100_000).map(|_| f64::from_bits(rng.next_u64())));
+        values.extend((0..100_000).map(|_| rng.uniform(-3e9, 3e9)));
+        for y in values {
+            assert_eq!(floor_clamped(y), y.floor().clamp(-1e9, 1e9) as i32, "{y:e}");
+        }
     }
 
     #[test]

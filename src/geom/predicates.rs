@@ -140,6 +140,14 @@ impl Orient for Checked {
         self.orient3d(pl[0], pl[1], pl[2], d)
     }
     fn orient3d(self, a: P3, b: P3, c: P3, d: P3) -> i8 {
+        if a.iter()
+            .chain(&b)
+            .chain(&c)
+            .chain(&d)
+            .all(|&x| surely_in_window(x))
+        {
+            return InRange.orient3d(a, b, c, d);
+        }
         let e = Exponents::of(a.iter().chain(&b).chain(&c).chain(&d).copied());
         match e.plan() {
             Plan::NonFinite => 0,
@@ -152,6 +160,9 @@ impl Orient for Checked {
         }
     }
     fn orient2d(self, a: [f64; 2], b: [f64; 2], c: [f64; 2]) -> i8 {
+        if a.iter().chain(&b).chain(&c).all(|&x| surely_in_window(x)) {
+            return InRange.orient2d(a, b, c);
+        }
         let e = Exponents::of(a.iter().chain(&b).chain(&c).copied());
         match e.plan() {
             Plan::NonFinite => 0,
@@ -163,6 +174,23 @@ impl Orient for Checked {
             Plan::Integers => exact::orient2d(a, b, c),
         }
     }
+}
+
+/// `2^(FAST_LOW + 52)`: every `f64` at least this large in magnitude is a multiple of
+/// `2^FAST_LOW` (its lowest mantissa bit is at most 52 places below its leading one).
+const FAST_LOW_NORMAL: f64 = f64::from_bits(((FAST_LOW + 52 + 1023) as u64) << 52);
+
+/// `2^FAST_TOP`.
+const FAST_TOP_BOUND: f64 = f64::from_bits(((FAST_TOP + 1023) as u64) << 52);
+
+/// A cheap sufficient test that `x` lies in the window where [`InRange`] is exact (zero, or
+/// `2^(FAST_LOW + 52) ≤ |x| < 2^FAST_TOP`): two comparisons instead of [`Exponents`]'s bit
+/// counts. NaN and infinities fail it. Values it rejects may still be in the window; the
+/// callers then decide through [`Exponents`] as before, so the answers do not change.
+#[inline]
+fn surely_in_window(x: f64) -> bool {
+    let m = x.abs();
+    m == 0.0 || (FAST_LOW_NORMAL..FAST_TOP_BOUND).contains(&m)
 }
 
 /// The exponent spread of a set of numbers: the largest `floor(log2 |x|)` and the smallest
@@ -488,6 +516,41 @@ mod tests {
         assert_eq!(Exponents::of([1e300, 1e-300]).window_scale(), None);
         assert!(Exponents::of([f64::INFINITY]).non_finite);
         assert_eq!(scale(3.0, 2000), 3.0 * 2f64.powi(1000) * 2f64.powi(1000));
+    }
+
+    /// The quick window test admits only values in the window, and admits the usual ones.
+    #[test]
+    fn the_quick_window_test_is_sufficient() {
+        assert_eq!(FAST_LOW_NORMAL, 2f64.powi(FAST_LOW + 52));
+        assert_eq!(FAST_TOP_BOUND, 2f64.powi(FAST_TOP));
+        let edges = [
+            0.0,
+            -0.0,
+            1.0,
+            -0.3,
+            FAST_LOW_NORMAL,
+            -FAST_LOW_NORMAL,
+            f64::from_bits(FAST_LOW_NORMAL.to_bits() - 1),
+            f64::from_bits(FAST_LOW_NORMAL.to_bits() + 1),
+            FAST_TOP_BOUND,
+            f64::from_bits(FAST_TOP_BOUND.to_bits() - 1),
+            -f64::from_bits(FAST_TOP_BOUND.to_bits() - 1),
+            f64::MIN_POSITIVE,
+            f64::from_bits(1),
+            f64::MAX,
+            f64::INFINITY,
+            f64::NAN,
+        ];
+        let mut rng = XorShift64::new(11);
+        let random = (0..20_000).map(|_| f64::from_bits(rng.next_u64()));
+        for x in edges.into_iter().chain(random) {
+            if surely_in_window(x) {
+                assert!(Exponents::of([x]).in_window(), "{x:e}");
+            }
+        }
+        assert!([0.0, 1.0, -0.3, 1e-70, 1e90]
+            .into_iter()
+            .all(surely_in_window));
     }
 
     /// The filtered side test agrees with the exact orientation, also where the filter

@@ -450,16 +450,16 @@ fn chart_triangles(chart: &[[f64; 2]], front: &[u32]) -> Result<Vec<[u32; 3]>, M
     };
     // A front that is not star-shaped about p0 (curves that ended at very different radii)
     // bounds the mesh all the same: inside by the even-odd rule.
-    let polygon: Vec<[f64; 2]> = if !use_front && m >= 3 {
+    let polygon = EvenOdd::new(if !use_front && m >= 3 {
         front.iter().map(|&v| chart[v as usize]).collect()
     } else {
         Vec::new()
-    };
+    });
     let inside = |c: [f64; 2]| {
         if use_front {
             c[0] * c[0] + c[1] * c[1] < disk || inside_star(chart, front, (a0, &rel), c)
         } else {
-            polygon.is_empty() || point_in_polygon(&polygon, c)
+            polygon.is_empty() || polygon.contains(c)
         }
     };
     // One pass in spade's order, straight into the result: beside the triangulation itself
@@ -606,6 +606,111 @@ fn rows_by_corner(
     Some((start, list))
 }
 
+/// A polygon for even-odd tests of many points: its edges filed by the rows of `y` they
+/// span, so that a point is tested against only the edges in its row instead of all of
+/// them. Only edges whose `y` range holds the point's `y` can change the answer, and each of
+/// those is in the point's row (the row of a `y` never decreases with it), so the answer is
+/// [`point_in_polygon`]'s, bit for bit.
+struct EvenOdd {
+    p: Vec<[f64; 2]>,
+    /// The lowest `y` and the rows per unit of `y`.
+    y0: f64,
+    inv: f64,
+    /// Edge `i` (from `p[i]` to `p[i + 1]`) is listed in the rows its `y` range meets:
+    /// row `r`'s edges are `edges[start[r]..start[r + 1]]`. Empty: every edge is tested.
+    start: Vec<u32>,
+    edges: Vec<u32>,
+}
+
+impl EvenOdd {
+    fn new(p: Vec<[f64; 2]>) -> EvenOdd {
+        let mut e = EvenOdd {
+            p,
+            y0: 0.0,
+            inv: 0.0,
+            start: Vec::new(),
+            edges: Vec::new(),
+        };
+        let m = e.p.len();
+        // Small polygons, and any with a non-finite coordinate, are tested edge by edge.
+        if m < 16 || !e.p.iter().flatten().all(|x| x.is_finite()) {
+            return e;
+        }
+        let lo = e.p.iter().map(|q| q[1]).fold(f64::INFINITY, f64::min);
+        let hi = e.p.iter().map(|q| q[1]).fold(f64::NEG_INFINITY, f64::max);
+        let rows = m;
+        let inv = rows as f64 / (hi - lo);
+        if !(inv.is_finite() && inv > 0.0) {
+            return e;
+        }
+        e.y0 = lo;
+        e.inv = inv;
+        let span = |i: usize| {
+            let (a, b) = (e.p[i][1], e.p[(i + 1) % m][1]);
+            (e.row(a.min(b)), e.row(a.max(b)))
+        };
+        let mut count = vec![0u32; rows + 1];
+        let mut total = 0usize;
+        for i in 0..m {
+            let (r0, r1) = span(i);
+            total += r1 - r0 + 1;
+            for c in &mut count[r0 + 1..=r1 + 1] {
+                *c += 1;
+            }
+        }
+        // Long edges across many rows: not worth filing (the answer is the same either way).
+        if total > 16 * m {
+            e.inv = 0.0;
+            return e;
+        }
+        for r in 0..rows {
+            count[r + 1] += count[r];
+        }
+        let mut fill = count.clone();
+        let mut edges = vec![0u32; total];
+        for i in 0..m {
+            let (r0, r1) = span(i);
+            for f in &mut fill[r0..=r1] {
+                edges[*f as usize] = i as u32;
+                *f += 1;
+            }
+        }
+        e.start = count;
+        e.edges = edges;
+        e
+    }
+
+    fn is_empty(&self) -> bool {
+        self.p.is_empty()
+    }
+
+    /// The row of `y` (clamped to the `p.len()` rows; NaN in the first).
+    #[inline]
+    fn row(&self, y: f64) -> usize {
+        (((y - self.y0) * self.inv).floor().max(0.0) as usize).min(self.p.len() - 1)
+    }
+
+    /// [`point_in_polygon`] of `c`.
+    fn contains(&self, c: [f64; 2]) -> bool {
+        if self.start.is_empty() {
+            return point_in_polygon(&self.p, c);
+        }
+        let r = self.row(c[1]);
+        let m = self.p.len();
+        let mut inside = false;
+        for &i in &self.edges[self.start[r] as usize..self.start[r + 1] as usize] {
+            let (a, b) = (self.p[i as usize], self.p[(i as usize + 1) % m]);
+            if (a[1] > c[1]) != (b[1] > c[1]) {
+                let x = a[0] + (c[1] - a[1]) * (b[0] - a[0]) / (b[1] - a[1]);
+                if c[0] < x {
+                    inside = !inside;
+                }
+            }
+        }
+        inside
+    }
+}
+
 fn point_in_polygon(p: &[[f64; 2]], c: [f64; 2]) -> bool {
     let m = p.len();
     let mut inside = false;
@@ -657,6 +762,34 @@ fn assemble<T: Scalar>(samples: &Samples<T>, pos: &[[f64; 3]], triangles: &[[u32
 mod tests {
     use super::*;
     use crate::geom::rng::XorShift64;
+
+    /// The filed even-odd test answers as the edge-by-edge one, on random polygons (also
+    /// self-intersecting ones, with repeated and horizontal edges) and on points at their
+    /// vertices' coordinates.
+    #[test]
+    fn filed_even_odd_test_agrees_with_every_edge() {
+        let mut rng = XorShift64::new(5);
+        for m in [3, 16, 17, 40, 200] {
+            for _ in 0..20 {
+                let mut p: Vec<[f64; 2]> = (0..m)
+                    .map(|_| [rng.uniform(-1.0, 1.0), rng.uniform(-1.0, 1.0)])
+                    .collect();
+                if m > 3 {
+                    p[1] = p[0];
+                    p[3][1] = p[2][1];
+                }
+                let e = EvenOdd::new(p.clone());
+                let mut probes: Vec<[f64; 2]> = (0..400)
+                    .map(|_| [rng.uniform(-1.2, 1.2), rng.uniform(-1.2, 1.2)])
+                    .collect();
+                probes.extend(p.iter().map(|q| [q[0] - 1e-3, q[1]]));
+                probes.extend([[0.0, f64::NAN], [0.0, f64::INFINITY], [0.0, -5.0]]);
+                for c in probes {
+                    assert_eq!(e.contains(c), point_in_polygon(&p, c), "{c:?}");
+                }
+            }
+        }
+    }
 
     /// A polygon star-shaped about the origin: `m` vertices at increasing angles.
     fn star(rng: &mut XorShift64, m: usize, wobble: f64) -> Vec<[f64; 2]> {

@@ -128,6 +128,10 @@ const REDO_ROUNDS: usize = 5;
 /// Holes of at most this many edges are opened and stitched again.
 const REDO_HOLE: usize = 48;
 
+/// Above any angle as computed (`atan2` of a non-negative `y` is at most π): bounds the part
+/// of a score after its glue.
+const MAX_MIN_ANGLE: f64 = 3.5;
+
 /// The candidate vertex of an edge that is not there yet: the edge's new point.
 const NEW: u32 = u32::MAX;
 
@@ -296,6 +300,9 @@ pub(crate) fn stitch<T: Scalar, F: NormalField<T>>(
     out
 }
 
+/// A remembered score: the epochs of its vertices, the bits of its reach, the score.
+type RememberedScore = ([u32; 3], u64, Option<f64>);
+
 /// A new point proposed for an edge, before it is committed.
 #[derive(Clone)]
 struct Proposal<T> {
@@ -333,6 +340,19 @@ struct Stitcher<'a, 'f, T, F> {
     rejected: HashSet<(u32, u32, u32), FastHash>,
     version: EdgeMap<u32>,
     heap: BinaryHeap<Candidate>,
+    /// Scratch list of [`Self::refresh`]'s candidates (kept to spare an allocation a call).
+    found: Vec<(f64, u32)>,
+    /// Whether [`Self::in_open_wedge`] remembers its angles in `wedge_angles` (only during a
+    /// [`Self::refresh`], when no vertex moves or comes and goes).
+    wedge_memo: std::cell::Cell<bool>,
+    /// The angle of vertex `w` about vertex `v` in `v`'s tangent frame, by `(v, w)`.
+    wedge_angles: std::cell::RefCell<HashMap<(u32, u32), f64, FastHash>>,
+    /// A count per vertex of the changes to the edges and boundary edges at it (see
+    /// [`Self::touch`]).
+    epoch: Vec<u32>,
+    /// [`Self::refresh`]'s scores by candidate `(a, b, x)`, with the epochs of `a`, `b`, `x`
+    /// and the bits of the reach they were computed for.
+    scores: HashMap<(u32, u32, u32), RememberedScore, FastHash>,
 }
 
 impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
@@ -400,7 +420,7 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
         for &v in &boundary {
             points.insert(v, pos[v as usize]);
         }
-        let mut faces = FaceGrid::new(cell);
+        let mut faces = FaceGrid::new(cell, tris.len());
         for (f, t) in tris.iter().enumerate() {
             faces.insert(f as u32, corners(&pos, *t));
         }
@@ -425,6 +445,11 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
             rejected: HashSet::default(),
             version: HashMap::default(),
             heap: BinaryHeap::new(),
+            found: Vec::new(),
+            wedge_memo: std::cell::Cell::new(false),
+            wedge_angles: std::cell::RefCell::new(HashMap::default()),
+            epoch: Vec::new(),
+            scores: HashMap::default(),
         }
     }
 
@@ -478,7 +503,10 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
         let mut best: Option<(f64, u32)> = None;
         // The nearest boundary vertices within reach, a bounded number of them: the work
         // per edge stays constant where boundary vertices crowd.
-        let mut found = Vec::new();
+        self.wedge_angles.get_mut().clear();
+        self.wedge_memo.set(true);
+        let mut found = std::mem::take(&mut self.found);
+        found.clear();
         self.points.near(mid, reach, |x| {
             if x != a && x != b {
                 let d = dist(self.pos[x as usize], mid);
@@ -493,16 +521,24 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
             found.truncate(MAX_CANDIDATES);
         }
         found.sort_unstable_by(order);
-        for (_, x) in found {
+        for &(_, x) in &found {
             if !self.on_boundary(x) || self.rejected.contains(&(a, b, x)) {
                 continue;
             }
-            if let Some(score) = self.score(a, b, x, reach, MIN_ANGLE_DEG.to_radians()) {
+            // A score is 4 per glued edge plus the smallest angle (below 3.5): a candidate
+            // with less glue than the best so far cannot beat it (a tie keeps the best) and
+            // is not scored.
+            if best.is_some_and(|(s, _)| 4.0 * f64::from(self.glue(a, b, x)) + MAX_MIN_ANGLE <= s) {
+                continue;
+            }
+            if let Some(score) = self.refresh_score(a, b, x, reach) {
                 if best.is_none_or(|(s, _)| score > s) {
                     best = Some((score, x));
                 }
             }
         }
+        self.found = found;
+        self.wedge_memo.set(false);
         // A new point in front of the edge, if no existing vertex makes a good enough
         // triangle there.
         if best.is_none_or(|(s, _)| s < NEW_POINT_SCORE)
@@ -522,6 +558,37 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
         }
     }
 
+    /// [`Self::score`] with the refresh's angle floor, remembered: a score reads the
+    /// positions, normals and provenance of `a`, `b`, `x` (which do not change once a vertex
+    /// is registered), the reach, and the edges and boundary edges at `a`, `b` and `x` (each
+    /// change to those bumps the vertex's epoch). So a remembered score with the same epochs
+    /// and reach is the score computed anew.
+    fn refresh_score(&mut self, a: u32, b: u32, x: u32, reach: f64) -> Option<f64> {
+        let epochs = [a, b, x].map(|v| self.epoch.get(v as usize).copied().unwrap_or(0));
+        if let Some(&(e, r, score)) = self.scores.get(&(a, b, x)) {
+            if e == epochs && r == reach.to_bits() {
+                return score;
+            }
+        }
+        let score = self.score(a, b, x, reach, MIN_ANGLE_DEG.to_radians());
+        self.scores
+            .insert((a, b, x), (epochs, reach.to_bits(), score));
+        score
+    }
+
+    /// Notes a change at vertex `v` (its edges, its boundary edges, or the vertex itself):
+    /// remembered scores that involve it are stale.
+    fn touch(&mut self, v: u32) {
+        let v = v as usize;
+        if v >= self.epoch.len() {
+            if v > self.pos.len() {
+                return;
+            }
+            self.epoch.resize(v + 1, 0);
+        }
+        self.epoch[v] = self.epoch[v].wrapping_add(1);
+    }
+
     /// Whether edge `a → b` may get a new point in front of it.
     fn may_grow(&self, a: u32, b: u32) -> bool {
         self.growth.new_points
@@ -539,6 +606,7 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
         }
         let p = self.proposals[&(a, b)].clone()?;
         let v = self.pos.len() as u32;
+        self.touch(v);
         self.pos.push(p.pos);
         self.nrm.push(p.normal);
         self.prov.push(Provenance {
@@ -554,6 +622,7 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
 
     /// Takes back the vertex on trial.
     fn retract(&mut self) {
+        self.touch(self.pos.len() as u32 - 1);
         self.pos.pop();
         self.nrm.pop();
         self.prov.pop();
@@ -713,20 +782,24 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
             }
         }
         let (ff, gg) = (dot(face, face), dot(field, field));
-        let angles = angles([pa, pb, px]);
-        let min_angle = angles[0].min(angles[1]).min(angles[2]);
-        // A hole's last sliver (a corner almost on the opposite edge) has no normal to speak
-        // of: it goes in whichever way it faces, and the flips that follow remove it.
-        let sliver = min_floor == 0.0 && min_angle < SLIVER_DEG.to_radians();
         // Against each corner's normal, not only their sum: corners on opposite sides of a
         // thin tube sum to almost nothing, and a triangle across the tube must not pass.
         let cos_tilt = MAX_TILT_DEG.to_radians().cos();
         let tilted = [self.nrm[a as usize], self.nrm[b as usize], nx]
             .iter()
             .any(|n| dot(face, *n) < cos_tilt * (ff * dot(*n, *n)).sqrt());
-        if !(ff > 0.0 && gg > 0.0)
-            || (!sliver && (dot(face, field) < cos_tilt * (ff * gg).sqrt() || tilted))
-        {
+        let leans = dot(face, field) < cos_tilt * (ff * gg).sqrt() || tilted;
+        // With a floor on the angles no triangle is a sliver (below): the facing test comes
+        // before the angles, which are dearer.
+        if !(ff > 0.0 && gg > 0.0) || (min_floor != 0.0 && leans) {
+            return None;
+        }
+        let angles = angles([pa, pb, px]);
+        let min_angle = angles[0].min(angles[1]).min(angles[2]);
+        // A hole's last sliver (a corner almost on the opposite edge) has no normal to speak
+        // of: it goes in whichever way it faces, and the flips that follow remove it.
+        let sliver = min_floor == 0.0 && min_angle < SLIVER_DEG.to_radians();
+        if !sliver && leans {
             return None;
         }
         // Corners where both of the triangle's edges are boundary edges now: there it fills
@@ -744,23 +817,31 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
         // wedge yet). A hole's last triangles are ears of its loop: the exact test alone
         // decides those.
         if min_floor > 0.0
-            && !(self.in_open_wedge(a, px, pb)
-                && self.in_open_wedge(b, pa, px)
+            && !(self.in_open_wedge(a, x, b)
+                && self.in_open_wedge(b, a, x)
                 && (self.prov[x as usize].curve == Provenance::CLOSING_CURVE
                     && !self.on_boundary(x)
-                    || self.in_open_wedge(x, pb, pa)))
+                    || self.in_open_wedge(x, b, a)))
         {
             return None;
         }
-        let glue = u8::from(self.is_boundary_edge(x, a)) + u8::from(self.is_boundary_edge(b, x));
-        Some(4.0 * f64::from(glue) + min_angle)
+        Some(4.0 * f64::from(self.glue(a, b, x)) + min_angle)
+    }
+
+    /// How many of triangle `(b, a, x)`'s other edges close a boundary edge (its score's
+    /// integer part, times 4).
+    fn glue(&self, a: u32, b: u32, x: u32) -> u8 {
+        u8::from(self.is_boundary_edge(x, a)) + u8::from(self.is_boundary_edge(b, x))
     }
 
     /// Whether the wedge at boundary vertex `v` from the direction of `from` counter-clockwise
     /// to that of `to` (about `v`'s field normal) lies in one of `v`'s open wedges: from a
     /// boundary in-edge's source counter-clockwise to a boundary out-edge's target, with no
     /// other boundary edge of `v` between.
-    fn in_open_wedge(&self, v: u32, from: [f64; 3], to: [f64; 3]) -> bool {
+    ///
+    /// During [`Self::refresh`] the angles about `v` are remembered (its candidates share
+    /// their edge's ends and the ends' boundary neighbours): the same value as computed anew.
+    fn in_open_wedge(&self, v: u32, from: u32, to: u32) -> bool {
         let (Some(outs), Some(ins)) = (self.bout.get(&v), self.bin.get(&v)) else {
             return false;
         };
@@ -774,17 +855,27 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
         };
         let e1 = unit(cross(helper, n));
         let e2 = cross(n, e1);
-        let angle = |q: [f64; 3]| {
-            let d = sub(q, p);
-            dot(d, e2).atan2(dot(d, e1))
+        let memo = self.wedge_memo.get();
+        let angle = |w: u32| {
+            if memo {
+                if let Some(&t) = self.wedge_angles.borrow().get(&(v, w)) {
+                    return t;
+                }
+            }
+            let d = sub(self.pos[w as usize], p);
+            let t = dot(d, e2).atan2(dot(d, e1));
+            if memo {
+                self.wedge_angles.borrow_mut().insert((v, w), t);
+            }
+            t
         };
         let ccw = |from: f64, to: f64| (to - from).rem_euclid(std::f64::consts::TAU);
         let (af, at) = (angle(from), angle(to));
         let span = ccw(af, at);
         for &z in ins {
-            let az = angle(self.pos[z as usize]);
+            let az = angle(z);
             for &y in outs {
-                let ay = angle(self.pos[y as usize]);
+                let ay = angle(y);
                 let wedge = ccw(az, ay);
                 // The triangle's span must lie inside the wedge…
                 if !(ccw(az, af) <= wedge && ccw(az, af) + span <= wedge + 1e-12) {
@@ -793,7 +884,7 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
                 // …and no other boundary edge of v may cut the wedge.
                 let cut = outs.iter().chain(ins.iter()).any(|&u| {
                     u != z && u != y && {
-                        let au = ccw(az, angle(self.pos[u as usize]));
+                        let au = ccw(az, angle(u));
                         au > 0.0 && au < wedge
                     }
                 });
@@ -827,10 +918,22 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
     /// corners it shares with them (exact).
     fn meets_nothing(&self, a: u32, b: u32, x: u32) -> bool {
         let t = [b, a, x];
+        let c = corners(&self.pos, t);
+        let (lo, hi) = bounds(&c);
         let mut hit = false;
-        self.faces.near(&corners(&self.pos, t), |f| {
+        self.faces.near(&c, |f| {
             let g = self.tris[f as usize];
-            hit = hit || (g != DEAD && faces_intersect(&self.pos, t, g));
+            if hit || g == DEAD {
+                return;
+            }
+            // Closed triangles whose boxes are apart have no common point: only faces whose
+            // boxes meet this one's go to the exact test (a non-finite corner, which the
+            // exact test answers `false` for, may be rejected here as well).
+            let (glo, ghi) = bounds(&corners(&self.pos, g));
+            if (0..3).any(|k| ghi[k] < lo[k] || glo[k] > hi[k]) {
+                return;
+            }
+            hit = faces_intersect(&self.pos, t, g);
         });
         !hit
     }
@@ -1432,6 +1535,9 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
     fn remove_triangle(&mut self, f: u32) {
         let t = self.tris[f as usize];
         self.tris[f as usize] = DEAD;
+        for v in t {
+            self.touch(v);
+        }
         for k in 0..3 {
             let (u, v) = (t[k], t[(k + 1) % 3]);
             self.edges.remove(&(u, v));
@@ -1462,6 +1568,9 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
         let f = self.tris.len() as u32;
         self.tris.push(t);
         self.faces.insert(f, corners(&self.pos, t));
+        for v in t {
+            self.touch(v);
+        }
         for k in 0..3 {
             let (u, v) = (t[k], t[(k + 1) % 3]);
             self.edges.insert((u, v), f);
@@ -1559,6 +1668,15 @@ fn unit(a: [f64; 3]) -> [f64; 3] {
     a.map(|x| x / l)
 }
 
+/// The corners' smallest and largest coordinates.
+#[inline]
+fn bounds(c: &[[f64; 3]; 3]) -> ([f64; 3], [f64; 3]) {
+    (
+        [0, 1, 2].map(|k| c[0][k].min(c[1][k]).min(c[2][k])),
+        [0, 1, 2].map(|k| c[0][k].max(c[1][k]).max(c[2][k])),
+    )
+}
+
 fn corners(pos: &[[f64; 3]], t: [u32; 3]) -> [[f64; 3]; 3] {
     t.map(|v| pos[v as usize])
 }
@@ -1633,6 +1751,7 @@ fn pinched_fans(triangles: &[[u32; 3]], candidate: impl Fn(u32) -> bool) -> (Vec
     }
     let (mut pinched, mut drop) = (Vec::new(), Vec::new());
     let mut group: Vec<usize> = Vec::new();
+    let (mut roots, mut sizes): (Vec<usize>, Vec<(usize, usize)>) = (Vec::new(), Vec::new());
     for v in 0..n {
         let faces = &star[start[v] as usize..start[v + 1] as usize];
         if faces.len() < 2 {
@@ -1648,7 +1767,9 @@ fn pinched_fans(triangles: &[[u32; 3]], candidate: impl Fn(u32) -> bool) -> (Vec
             }
             i
         }
-        for i in 0..faces.len() {
+        // Once every triangle is in one fan (the usual case) there is nothing to find.
+        let mut fans = faces.len();
+        'pairs: for i in 0..faces.len() {
             let ti = triangles[faces[i] as usize];
             for j in i + 1..faces.len() {
                 let tj = triangles[faces[j] as usize];
@@ -1660,12 +1781,20 @@ fn pinched_fans(triangles: &[[u32; 3]], candidate: impl Fn(u32) -> bool) -> (Vec
                     let (a, b) = (root(&mut group, i), root(&mut group, j));
                     if a != b {
                         group[a.max(b)] = a.min(b);
+                        fans -= 1;
+                        if fans == 1 {
+                            break 'pairs;
+                        }
                     }
                 }
             }
         }
-        let roots: Vec<usize> = (0..faces.len()).map(|i| root(&mut group, i)).collect();
-        let mut sizes: Vec<(usize, usize)> = Vec::new();
+        if fans == 1 {
+            continue;
+        }
+        roots.clear();
+        roots.extend((0..faces.len()).map(|i| root(&mut group, i)));
+        sizes.clear();
         for &r in &roots {
             match sizes.iter_mut().find(|(g, _)| *g == r) {
                 Some(e) => e.1 += 1,
@@ -1700,7 +1829,7 @@ struct PointGrid {
 }
 
 fn cell_of(inv: f64, p: [f64; 3]) -> Cell {
-    let k = |x: f64| (x * inv).floor().clamp(-1e9, 1e9) as i32;
+    let k = |x: f64| crate::geom::grid::floor_clamped(x * inv);
     (k(p[0]), k(p[1]), k(p[2]))
 }
 
@@ -1748,10 +1877,11 @@ struct FaceGrid {
 }
 
 impl FaceGrid {
-    fn new(cell: f64) -> Self {
+    /// A grid of cells of side `cell` with room for about `faces` triangles.
+    fn new(cell: f64, faces: usize) -> Self {
         FaceGrid {
             inv: 1.0 / cell,
-            cells: HashMap::default(),
+            cells: HashMap::with_capacity_and_hasher(faces, FastHash::default()),
             large: Vec::new(),
         }
     }
