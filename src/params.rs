@@ -122,9 +122,11 @@ pub struct MeshParams {
     /// Initial direction (projected onto the tangent plane at `p0`); automatic: the
     /// coordinate axis least aligned with the normal at `p0`.
     pub w00: Option<[f64; 3]>,
-    /// Initial step Δt; automatic: a tenth of the step scale.
+    /// Initial step Δt; automatic: a tenth of the step scale, or twice `beta_max` (in radians)
+    /// step scales when that is smaller.
     pub dt: Option<f64>,
-    /// Smallest step (steps are clamped to `[dt_min, dt_max]`); automatic: 10⁻³ step scales.
+    /// Smallest step (steps are clamped to `[dt_min, dt_max]`); automatic: 10⁻³ step scales,
+    /// or a quarter of `beta_min` (in radians) step scales when that is smaller.
     pub dt_min: Option<f64>,
     /// Largest step; automatic: half the step scale.
     pub dt_max: Option<f64>,
@@ -341,8 +343,16 @@ impl MeshParams {
             given: self.clone(),
             scales,
             w00,
-            dt: self.dt.unwrap_or(AUTO_DT * scales.step),
-            dt_min: self.dt_min.unwrap_or(AUTO_DT_MIN * scales.step),
+            // A β band far narrower than usual asks for steps below the usual clamps: the
+            // automatic Δt and dt_min follow it there (a step of length h turns the normal by
+            // about h / ρ radians), so that the band can be met and a budget, not the first
+            // step, ends the run.
+            dt: self
+                .dt
+                .unwrap_or(AUTO_DT.min(2.0 * self.beta_max.radians()) * scales.step),
+            dt_min: self
+                .dt_min
+                .unwrap_or(AUTO_DT_MIN.min(0.25 * self.beta_min.radians()) * scales.step),
             dt_max: self.dt_max.unwrap_or(AUTO_DT_MAX * scales.step),
             max_radius: self.max_radius.unwrap_or(
                 if shape.integrability_defect < INTEGRABLE_DEFECT {

@@ -334,3 +334,28 @@ fn valid_or_empty(result: Result<liemesh::MeshRun<f64>, liemesh::MeshError>) {
         Err(e) => assert!(matches!(e, liemesh::MeshError::Empty { .. }), "{e}"),
     }
 }
+
+/// A β band far narrower than usual (0.001°–0.002°) from defaults: the automatic Δt and dt_min
+/// follow the band, so the curves start and the point budget, not the first step, ends the
+/// run, and the run says so (it used to end with "only 1 sample point").
+#[test]
+fn a_very_narrow_beta_band_runs_until_the_point_budget_and_says_so() {
+    let sphere = Invariant::from_numbers(&[1.0, 1.0, 1.0, 0.0, 0.0, 0.0]).unwrap();
+    let mut params = MeshParams::at([1.0, 0.0, 0.0]);
+    params.beta_min = Angle::from_degrees(0.001);
+    params.beta_max = Angle::from_degrees(0.002);
+    params.max_points = 20_000;
+    let run = liemesh::run(&LieField::<f64>::new(&sphere), &params).unwrap();
+    assert!(
+        run.samples.points.len() >= 19_000,
+        "{}",
+        run.samples.points.len()
+    );
+    let cut = run.cut_short();
+    assert!(
+        cut.iter().any(|why| why.contains("point budget")),
+        "{cut:?}"
+    );
+    assert!(run.validation.is_valid());
+    fuzz_checks::check_mesh(&run.mesh).unwrap();
+}
