@@ -269,7 +269,7 @@ pub(crate) fn stitch<T: Scalar, F: NormalField<T>>(
             break;
         }
         let (removed, near) = s.open_around(&stuck, round + 1);
-        out.removed += removed;
+        out.removed += removed.len();
         opened = Some(near);
     }
     // Holes that are still open between fronts that met are filled through charts of their
@@ -1080,18 +1080,20 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
 
     /// The last resort for holes between fronts that met (every vertex of the loop
     /// [`Rim::Open`], at most [`CHART_HOLE`] edges, on an integrable field): each is filled
-    /// through a chart of its own ([`Self::fill_by_chart`]); a hole whose chart fails is
-    /// opened one ring wider and tried again, up to [`CHART_ATTEMPTS`] times. Returns how
-    /// many triangles it added (and counts the removed ones and the new vertices in `out`).
+    /// through a chart of its own ([`Self::fill_by_chart`]); the holes whose charts fail are
+    /// opened wider (one more ring of triangles each time) and tried again, up to
+    /// [`CHART_ATTEMPTS`] times. A hole that never fits stays opened: where it reaches the
+    /// surface's own boundary (such as the hole around a cone's apex) it merges into it rather
+    /// than stay an extra hole. Returns how many triangles it added (and counts the removed
+    /// ones and the new vertices in `out`).
     fn fill_holes_by_chart(&mut self, out: &mut Stitched) -> usize {
         if !self.growth.new_points {
             return 0;
         }
         let mut added = 0;
         for attempt in 0..=CHART_ATTEMPTS {
-            let loops = self.open_loops(CHART_HOLE);
             let mut failed = Vec::new();
-            for ring in loops {
+            for ring in self.open_loops(CHART_HOLE) {
                 match self.fill_by_chart(&ring) {
                     Some((triangles, vertices)) => {
                         added += triangles;
@@ -1104,7 +1106,7 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
                 break;
             }
             let (removed, _) = self.open_around(&failed, attempt + 1);
-            out.removed += removed;
+            out.removed += removed.len();
         }
         added
     }
@@ -1154,14 +1156,14 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
             }
         }
         let length = dot(sum, sum).sqrt();
-        if !(length > 0.0) {
+        if length.is_nan() || length <= 0.0 {
             return None;
         }
         let n = sum.map(|x| x / length);
-        if ring
-            .iter()
-            .any(|&v| !(dot(self.nrm[v as usize], n) > turn_cos))
-        {
+        if ring.iter().any(|&v| {
+            let c = dot(self.nrm[v as usize], n);
+            c.is_nan() || c <= turn_cos
+        }) {
             return None;
         }
         // A frame right-handed about n: counter-clockwise in the chart is counter-clockwise
@@ -1191,7 +1193,7 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
             })
             .sum::<f64>()
             * 0.5;
-        if !(area > 0.0) || !simple_polygon(&corners2) {
+        if area.is_nan() || area <= 0.0 || !simple_polygon(&corners2) {
             return None;
         }
         let mean_edge = (0..m)
@@ -1358,7 +1360,7 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
         for _ in 0..CHART_HOPS {
             let d = sub(target, at);
             let length = dot(d, d).sqrt();
-            if !(length > 0.0) {
+            if length.is_nan() || length <= 0.0 {
                 return None;
             }
             let hop = length.min(hop_length);
@@ -1505,7 +1507,11 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
     /// Removes the triangles within `rings` rings of the vertices of `loops` (each round
     /// opens wider: a twist the last opening did not reach may be one ring farther); returns
     /// how many, and the vertices of the removed triangles.
-    fn open_around(&mut self, loops: &[Vec<u32>], rings: usize) -> (usize, HashSet<u32, FastHash>) {
+    fn open_around(
+        &mut self,
+        loops: &[Vec<u32>],
+        rings: usize,
+    ) -> (Vec<[u32; 3]>, HashSet<u32, FastHash>) {
         let mut mark: HashSet<u32, FastHash> = loops.iter().flatten().copied().collect();
         let mut doomed: Vec<u32> = Vec::new();
         for ring in 0..rings {
@@ -1524,11 +1530,13 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
             }
         }
         let mut near = mark;
+        let mut removed = Vec::with_capacity(doomed.len());
         for &f in &doomed {
+            removed.push(self.tris[f as usize]);
             near.extend(self.tris[f as usize]);
             self.remove_triangle(f);
         }
-        (doomed.len(), near)
+        (removed, near)
     }
 
     /// Removes triangle `f` (it stays as a tombstone until the end).
