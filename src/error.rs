@@ -6,6 +6,7 @@ use thiserror::Error;
 ///
 /// Each message says what was wrong and what to do about it.
 #[derive(Debug, Clone, PartialEq, Error)]
+#[non_exhaustive]
 pub enum MeshError {
     /// A parameter is NaN or infinite.
     #[error("parameter `{name}` is {value}; it must be a finite number")]

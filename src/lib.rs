@@ -80,6 +80,7 @@ use scalar::Scalar;
 
 /// Everything one meshing run produced.
 #[derive(Clone, Debug)]
+#[non_exhaustive]
 pub struct MeshRun<T> {
     /// The sample points in the working precision, with curves and step records.
     pub samples: sample::Samples<T>,
