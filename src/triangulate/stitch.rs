@@ -847,14 +847,7 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
         };
         let p = self.pos[v as usize];
         let n = self.nrm[v as usize];
-        // A tangent frame at v.
-        let helper = if n[0].abs() < 0.9 {
-            [1.0, 0.0, 0.0]
-        } else {
-            [0.0, 1.0, 0.0]
-        };
-        let e1 = unit(cross(helper, n));
-        let e2 = cross(n, e1);
+        let (e1, e2) = tangent_frame(n);
         let memo = self.wedge_memo.get();
         let angle = |w: u32| {
             if memo {
@@ -1166,15 +1159,9 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
         }) {
             return None;
         }
-        // A frame right-handed about n: counter-clockwise in the chart is counter-clockwise
-        // about the normal, the mesh's orientation.
-        let helper = if n[0].abs() < 0.9 {
-            [1.0, 0.0, 0.0]
-        } else {
-            [0.0, 1.0, 0.0]
-        };
-        let e1 = unit(cross(helper, n));
-        let e2 = cross(n, e1);
+        // Counter-clockwise in the chart is counter-clockwise about the normal, the mesh's
+        // orientation.
+        let (e1, e2) = tangent_frame(n);
         let chart = |q: [f64; 3]| {
             let d = sub(q, centre);
             [dot(d, e1), dot(d, e2)]
@@ -1604,6 +1591,17 @@ fn remove(list: Option<&mut Vec<u32>>, v: u32) -> bool {
         },
         None => false,
     }
+}
+
+/// Two unit vectors across the unit normal `n`, the frame `(e1, e2, n)` right-handed.
+fn tangent_frame(n: [f64; 3]) -> ([f64; 3], [f64; 3]) {
+    let helper = if n[0].abs() < 0.9 {
+        [1.0, 0.0, 0.0]
+    } else {
+        [0.0, 1.0, 0.0]
+    };
+    let e1 = unit(cross(helper, n));
+    (e1, cross(n, e1))
 }
 
 /// Whether the closed polygon `p` is simple: no two edges meet but neighbours at their
