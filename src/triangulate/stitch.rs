@@ -607,17 +607,24 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
         let p = self.proposals[&(a, b)].clone()?;
         let v = self.pos.len() as u32;
         self.touch(v);
-        self.pos.push(p.pos);
-        self.nrm.push(p.normal);
+        self.push_vertex(p.pos, p.normal, p.s, p.theta, p.point);
+        Some(v)
+    }
+
+    /// Appends a new vertex on the surface (position and unit normal in `f64`, the point in
+    /// the working precision) with closing provenance at arc length `s` and chart angle
+    /// `theta`.
+    fn push_vertex(&mut self, q: [f64; 3], normal: [f64; 3], s: f64, theta: f64, point: Vec3<T>) {
+        self.pos.push(q);
+        self.nrm.push(normal);
         self.prov.push(Provenance {
             curve: Provenance::CLOSING_CURVE,
             step: 0,
-            s: p.s,
-            theta: p.theta,
+            s,
+            theta,
         });
-        self.work.push(p.point);
+        self.work.push(point);
         self.rim.push(Rim::Open);
-        Some(v)
     }
 
     /// Takes back the vertex on trial.
@@ -910,7 +917,12 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
     /// Whether triangle `(b, a, x)` meets no triangle near it other than along the edges and
     /// corners it shares with them (exact).
     fn meets_nothing(&self, a: u32, b: u32, x: u32) -> bool {
-        let t = [b, a, x];
+        self.face_meets_nothing([b, a, x])
+    }
+
+    /// Whether triangle `t` meets no triangle near it other than along the edges and corners
+    /// it shares with them (exact).
+    fn face_meets_nothing(&self, t: [u32; 3]) -> bool {
         let c = corners(&self.pos, t);
         let (lo, hi) = bounds(&c);
         let mut hit = false;
@@ -1041,20 +1053,11 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
             return false;
         }
         let x = self.pos.len() as u32;
-        self.pos.push(q);
-        self.nrm.push(normal);
         let (s, theta) = ring.iter().fold((f64::INFINITY, 0.0), |(s, th), &v| {
             let p = &self.prov[v as usize];
             (s.min(p.s), th + p.theta / m)
         });
-        self.prov.push(Provenance {
-            curve: Provenance::CLOSING_CURVE,
-            step: 0,
-            s: s + length,
-            theta,
-        });
-        self.work.push(point);
-        self.rim.push(Rim::Open);
+        self.push_vertex(q, normal, s + length, theta, point);
         let n = ring.len();
         let fits = (0..n).all(|i| {
             let (a, b) = (ring[i], ring[(i + 1) % n]);
@@ -1289,16 +1292,7 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
             };
             let (q, normal, _) = point;
             index.insert(i, self.pos.len() as u32);
-            self.pos.push(q);
-            self.nrm.push(normal);
-            self.prov.push(Provenance {
-                curve: Provenance::CLOSING_CURVE,
-                step: 0,
-                s: s0 + dist(q, centre),
-                theta,
-            });
-            self.work.push(point.2);
-            self.rim.push(Rim::Open);
+            self.push_vertex(q, normal, s0 + dist(q, centre), theta, point.2);
         }
         let triangles: Vec<[u32; 3]> = faces
             .iter()
@@ -1403,12 +1397,7 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
         }) {
             return false;
         }
-        let mut hit = false;
-        self.faces.near(&c, |f| {
-            let g = self.tris[f as usize];
-            hit = hit || (g != DEAD && faces_intersect(&self.pos, t, g));
-        });
-        !hit
+        self.face_meets_nothing(t)
     }
 
     /// Whether triangle `t` keeps clear of the other vertices of `ring` (a loop's ear must
