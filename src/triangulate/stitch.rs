@@ -93,6 +93,92 @@ pub struct Stitched {
 
 type EdgeMap<V> = HashMap<(u32, u32), V, FastHash>;
 
+/// The directed edges of the triangles, as a set.
+///
+/// The chart's edges are filed once in compressed rows by source (no hashing), each with a
+/// flag that says whether it is still there; edges the chart did not have are kept in lists
+/// by source.
+struct EdgeSet {
+    /// The targets of the chart's edges from `u` are `targets[start[u]..start[u + 1]]`.
+    start: Vec<u32>,
+    targets: Vec<u32>,
+    /// Whether each of `targets` is still an edge.
+    present: Vec<bool>,
+    /// The targets of the other edges, by source (empty beyond its length).
+    added: Vec<Vec<u32>>,
+}
+
+impl EdgeSet {
+    /// The edges of `tris`, whose corners are below `vertices`.
+    fn new(vertices: usize, tris: &[[u32; 3]]) -> Self {
+        let mut start = vec![0u32; vertices + 1];
+        for t in tris {
+            for &u in t {
+                start[u as usize + 1] += 1;
+            }
+        }
+        for v in 0..vertices {
+            start[v + 1] += start[v];
+        }
+        let mut fill = start.clone();
+        let mut targets = vec![0u32; 3 * tris.len()];
+        for t in tris {
+            for k in 0..3 {
+                let u = t[k] as usize;
+                targets[fill[u] as usize] = t[(k + 1) % 3];
+                fill[u] += 1;
+            }
+        }
+        EdgeSet {
+            start,
+            present: vec![true; targets.len()],
+            targets,
+            added: Vec::new(),
+        }
+    }
+
+    /// The positions in `targets` of the chart's edges from `u`.
+    fn chart_row(&self, u: u32) -> std::ops::Range<usize> {
+        let u = u as usize;
+        match (self.start.get(u), self.start.get(u + 1)) {
+            (Some(&s), Some(&e)) => s as usize..e as usize,
+            _ => 0..0,
+        }
+    }
+
+    fn contains(&self, u: u32, v: u32) -> bool {
+        self.chart_row(u)
+            .any(|i| self.targets[i] == v && self.present[i])
+            || self.added.get(u as usize).is_some_and(|l| l.contains(&v))
+    }
+
+    fn insert(&mut self, u: u32, v: u32) {
+        if let Some(i) = self.chart_row(u).find(|&i| self.targets[i] == v) {
+            self.present[i] = true;
+            return;
+        }
+        let u = u as usize;
+        if u >= self.added.len() {
+            self.added.resize(u + 1, Vec::new());
+        }
+        if !self.added[u].contains(&v) {
+            self.added[u].push(v);
+        }
+    }
+
+    fn remove(&mut self, u: u32, v: u32) {
+        // (Every copy, should the chart list an edge twice.)
+        for i in self.chart_row(u) {
+            if self.targets[i] == v {
+                self.present[i] = false;
+            }
+        }
+        if let Some(l) = self.added.get_mut(u as usize) {
+            l.retain(|&w| w != v);
+        }
+    }
+}
+
 /// Where a vertex stands with respect to the surface's own boundary.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub(crate) enum Rim {
@@ -229,7 +315,7 @@ pub(crate) fn stitch<T: Scalar, F: NormalField<T>>(
                 Some(c.x)
             };
             match x {
-                Some(x) if s.acceptable(c.a, c.b, x) => {
+                Some(x) if s.acceptable(c.a, c.b, x, c.x == NEW) => {
                     if c.x == NEW {
                         out.vertices += 1;
                         s.register(x, c.a, c.b);
@@ -324,13 +410,15 @@ struct Stitcher<'a, 'f, T, F> {
     tris: Vec<[u32; 3]>,
     /// How many triangles the chart gave (the rest are the stitching's).
     initial: usize,
-    /// Directed edge → triangle.
-    edges: EdgeMap<u32>,
-    /// Boundary edges by their source and by their target.
-    bout: HashMap<u32, Vec<u32>, FastHash>,
-    bin: HashMap<u32, Vec<u32>, FastHash>,
-    /// Mean length of the edges at each boundary vertex (at the start, or when added).
-    scale: HashMap<u32, f64, FastHash>,
+    /// The triangles' directed edges.
+    edges: EdgeSet,
+    /// Boundary edges by vertex: `bout[a]` the targets of those from `a`, `bin[b]` the
+    /// sources of those into `b` (like `scale`, one entry per vertex).
+    bout: Vec<Vec<u32>>,
+    bin: Vec<Vec<u32>>,
+    /// Mean length of the edges at each boundary vertex (at the start, or when added); `None`
+    /// for vertices that have not been on the boundary.
+    scale: Vec<Option<f64>>,
     /// Boundary vertices, for candidate searches.
     points: PointGrid,
     /// Triangles near the boundary, for the intersection tests.
@@ -366,47 +454,48 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
         let pos = std::mem::take(&mut mesh.vertices);
         let nrm = std::mem::take(&mut mesh.normals);
         let prov = std::mem::take(&mut mesh.provenance);
-        let mut edges: EdgeMap<u32> =
-            HashMap::with_capacity_and_hasher(3 * tris.len(), FastHash::default());
-        for (f, t) in tris.iter().enumerate() {
-            for k in 0..3 {
-                edges.insert((t[k], t[(k + 1) % 3]), f as u32);
-            }
-        }
-        let mut bout: HashMap<u32, Vec<u32>, FastHash> = HashMap::default();
-        let mut bin: HashMap<u32, Vec<u32>, FastHash> = HashMap::default();
+        let n = pos.len();
+        let edges = EdgeSet::new(n, &tris);
+        let mut bout: Vec<Vec<u32>> = vec![Vec::new(); n];
+        let mut bin: Vec<Vec<u32>> = vec![Vec::new(); n];
         for t in &tris {
             for k in 0..3 {
                 let (a, b) = (t[k], t[(k + 1) % 3]);
-                if !edges.contains_key(&(b, a)) {
-                    bout.entry(a).or_default().push(b);
-                    bin.entry(b).or_default().push(a);
+                if !edges.contains(b, a) {
+                    bout[a as usize].push(b);
+                    bin[b as usize].push(a);
                 }
             }
         }
         // Local scale: the mean length of the edges at each boundary vertex.
-        let mut scale: HashMap<u32, (f64, u32), FastHash> = bout
-            .keys()
-            .chain(bin.keys())
-            .map(|&v| (v, (0.0, 0)))
+        let mut sums: Vec<Option<(f64, u32)>> = (0..n)
+            .map(|v| (!bout[v].is_empty() || !bin[v].is_empty()).then_some((0.0, 0)))
             .collect();
         for t in &tris {
             for k in 0..3 {
-                let (a, b) = (t[k], t[(k + 1) % 3]);
-                let l = dist(pos[a as usize], pos[b as usize]);
+                let (a, b) = (t[k] as usize, t[(k + 1) % 3] as usize);
+                if sums[a].is_none() && sums[b].is_none() {
+                    continue;
+                }
+                let l = dist(pos[a], pos[b]);
                 for v in [a, b] {
-                    if let Some(e) = scale.get_mut(&v) {
+                    if let Some(e) = &mut sums[v] {
                         e.0 += l;
                         e.1 += 1;
                     }
                 }
             }
         }
-        let scale: HashMap<u32, f64, FastHash> = scale
+        let scale: Vec<Option<f64>> = sums
             .into_iter()
-            .map(|(v, (sum, n))| (v, if n > 0 { sum / n as f64 } else { 0.0 }))
+            .map(|e| e.map(|(sum, n)| if n > 0 { sum / n as f64 } else { 0.0 }))
             .collect();
-        let mut lengths: Vec<f64> = scale.values().copied().filter(|l| *l > 0.0).collect();
+        let mut lengths: Vec<f64> = scale
+            .iter()
+            .flatten()
+            .copied()
+            .filter(|l| *l > 0.0)
+            .collect();
         lengths.sort_by(f64::total_cmp);
         let cell = lengths
             .get(lengths.len() / 2)
@@ -414,16 +503,11 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
             .unwrap_or(1.0)
             .max(1e-300)
             * REACH;
-        let mut boundary: Vec<u32> = scale.keys().copied().collect();
-        boundary.sort_unstable();
         let mut points = PointGrid::new(cell);
-        for &v in &boundary {
-            points.insert(v, pos[v as usize]);
+        for v in (0..n).filter(|&v| scale[v].is_some()) {
+            points.insert(v as u32, pos[v]);
         }
-        let mut faces = FaceGrid::new(cell, tris.len());
-        for (f, t) in tris.iter().enumerate() {
-            faces.insert(f as u32, corners(&pos, *t));
-        }
+        let faces = FaceGrid::new(cell, &pos, &tris);
         let mut rim = rim.to_vec();
         rim.resize(pos.len(), Rim::Open);
         Stitcher {
@@ -454,7 +538,7 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
     }
 
     fn boundary_edges(&self) -> usize {
-        self.bout.values().map(Vec::len).sum()
+        self.bout.iter().map(Vec::len).sum()
     }
 
     /// The boundary edges in a deterministic order.
@@ -462,22 +546,23 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
         let mut list: Vec<(u32, u32)> = self
             .bout
             .iter()
-            .flat_map(|(&a, bs)| bs.iter().map(move |&b| (a, b)))
+            .enumerate()
+            .flat_map(|(a, bs)| bs.iter().map(move |&b| (a as u32, b)))
             .collect();
         list.sort_unstable();
         list
     }
 
     fn is_boundary_edge(&self, a: u32, b: u32) -> bool {
-        self.bout.get(&a).is_some_and(|l| l.contains(&b))
+        self.bout[a as usize].contains(&b)
     }
 
     fn on_boundary(&self, v: u32) -> bool {
-        self.bout.get(&v).is_some_and(|l| !l.is_empty())
+        !self.bout[v as usize].is_empty()
     }
 
     fn local(&self, v: u32) -> f64 {
-        self.scale.get(&v).copied().unwrap_or(0.0)
+        self.scale[v as usize].unwrap_or(0.0)
     }
 
     /// The length scale of edge `a → b`: its own length, or its ends' mean edge length if
@@ -625,6 +710,9 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
         });
         self.work.push(point);
         self.rim.push(Rim::Open);
+        self.bout.push(Vec::new());
+        self.bin.push(Vec::new());
+        self.scale.push(None);
     }
 
     /// Takes back the vertex on trial.
@@ -635,14 +723,16 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
         self.prov.pop();
         self.work.pop();
         self.rim.pop();
+        self.bout.pop();
+        self.bin.pop();
+        self.scale.pop();
     }
 
     /// Keeps the vertex on trial `v`, placed for edge `a → b`.
     fn register(&mut self, v: u32, a: u32, b: u32) {
         self.proposals.remove(&(a, b));
         let h = 0.5 * (self.local(a) + self.local(b));
-        self.scale
-            .insert(v, h.max(dist(self.pos[a as usize], self.pos[b as usize])));
+        self.scale[v as usize] = Some(h.max(dist(self.pos[a as usize], self.pos[b as usize])));
         self.points.insert(v, self.pos[v as usize]);
     }
 
@@ -737,8 +827,8 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
     fn refresh_near(&mut self, a: u32, b: u32, x: u32) {
         let mut around = vec![a, b, x];
         for v in [a, b, x] {
-            around.extend(self.bout.get(&v).into_iter().flatten());
-            around.extend(self.bin.get(&v).into_iter().flatten());
+            around.extend(&self.bout[v as usize]);
+            around.extend(&self.bin[v as usize]);
         }
         // And the boundary vertices about as close to the triangle as its own size.
         let c = corners(&self.pos, [a, b, x]);
@@ -755,10 +845,10 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
         around.dedup();
         let mut list = Vec::new();
         for v in around {
-            for &w in self.bout.get(&v).map(Vec::as_slice).unwrap_or(&[]) {
+            for &w in &self.bout[v as usize] {
                 list.push((v, w));
             }
-            for &u in self.bin.get(&v).map(Vec::as_slice).unwrap_or(&[]) {
+            for &u in &self.bin[v as usize] {
                 list.push((u, v));
             }
         }
@@ -778,7 +868,7 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
             return None;
         }
         // Each edge at most twice, once each way.
-        if self.edges.contains_key(&(a, x)) || self.edges.contains_key(&(x, b)) {
+        if self.edges.contains(a, x) || self.edges.contains(x, b) {
             return None;
         }
         let face = cross(sub(pa, pb), sub(px, pb));
@@ -849,9 +939,7 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
     /// During [`Self::refresh`] the angles about `v` are remembered (its candidates share
     /// their edge's ends and the ends' boundary neighbours): the same value as computed anew.
     fn in_open_wedge(&self, v: u32, from: u32, to: u32) -> bool {
-        let (Some(outs), Some(ins)) = (self.bout.get(&v), self.bin.get(&v)) else {
-            return false;
-        };
+        let (outs, ins) = (&self.bout[v as usize], &self.bin[v as usize]);
         let p = self.pos[v as usize];
         let n = self.nrm[v as usize];
         let (e1, e2) = tangent_frame(n);
@@ -897,10 +985,9 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
     }
 
     /// The full test for triangle `(b, a, x)`, including the exact intersection test against
-    /// the triangles near it.
-    fn acceptable(&self, a: u32, b: u32, x: u32) -> bool {
+    /// the triangles near it; `x` may be the new point on trial.
+    fn acceptable(&self, a: u32, b: u32, x: u32, on_trial: bool) -> bool {
         // (A vertex on trial is on no triangle yet.)
-        let on_trial = x as usize == self.pos.len() - 1 && !self.bin.contains_key(&x);
         if !self.is_boundary_edge(a, b) || !(on_trial || self.on_boundary(x)) {
             return false;
         }
@@ -1309,7 +1396,7 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
             return None;
         }
         for v in first_new..self.pos.len() as u32 {
-            self.scale.insert(v, mean_edge);
+            self.scale[v as usize] = Some(mean_edge);
             self.points.insert(v, self.pos[v as usize]);
         }
         for &t in &triangles {
@@ -1425,8 +1512,8 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
                 return None;
             }
             ring.push(v);
-            match self.bout.get(&v).map(Vec::as_slice) {
-                Some([next]) => v = *next,
+            match self.bout[v as usize].as_slice() {
+                [next] => v = *next,
                 _ => return None,
             }
         }
@@ -1451,7 +1538,7 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
                 if ring.len() > REDO_HOLE {
                     ok = false;
                 }
-                let Some(&w) = self.bout.get(&v).and_then(|l| l.first()) else {
+                let Some(&w) = self.bout[v as usize].first() else {
                     ok = false;
                     break;
                 };
@@ -1524,26 +1611,26 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
         }
         for k in 0..3 {
             let (u, v) = (t[k], t[(k + 1) % 3]);
-            self.edges.remove(&(u, v));
-            if self.edges.contains_key(&(v, u)) {
+            self.edges.remove(u, v);
+            if self.edges.contains(v, u) {
                 // Its twin is a boundary edge now.
-                self.bout.entry(v).or_default().push(u);
-                self.bin.entry(u).or_default().push(v);
+                self.bout[v as usize].push(u);
+                self.bin[u as usize].push(v);
             } else {
-                remove(self.bout.get_mut(&u), v);
-                remove(self.bin.get_mut(&v), u);
+                remove(&mut self.bout[u as usize], v);
+                remove(&mut self.bin[v as usize], u);
             }
         }
         for v in t {
-            if !self.scale.contains_key(&v) {
+            if self.scale[v as usize].is_none() {
                 self.points.insert(v, self.pos[v as usize]);
             }
             // The new boundary's scale: the longest of its boundary edges.
             let mut h = self.local(v);
-            for &w in self.bout.get(&v).map(Vec::as_slice).unwrap_or(&[]) {
+            for &w in &self.bout[v as usize] {
                 h = h.max(dist(self.pos[v as usize], self.pos[w as usize]));
             }
-            self.scale.insert(v, h);
+            self.scale[v as usize] = Some(h);
         }
     }
 
@@ -1557,27 +1644,26 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
         }
         for k in 0..3 {
             let (u, v) = (t[k], t[(k + 1) % 3]);
-            self.edges.insert((u, v), f);
-            if remove(self.bout.get_mut(&v), u) {
+            self.edges.insert(u, v);
+            if remove(&mut self.bout[v as usize], u) {
                 // The twin `v → u` was a boundary edge: now both are inside.
-                remove(self.bin.get_mut(&u), v);
+                remove(&mut self.bin[u as usize], v);
             } else {
-                self.bout.entry(u).or_default().push(v);
-                self.bin.entry(v).or_default().push(u);
+                self.bout[u as usize].push(v);
+                self.bin[v as usize].push(u);
             }
         }
     }
 }
 
-fn remove(list: Option<&mut Vec<u32>>, v: u32) -> bool {
-    match list {
-        Some(l) => match l.iter().position(|&w| w == v) {
-            Some(i) => {
-                l.swap_remove(i);
-                true
-            }
-            None => false,
-        },
+/// Removes `v` from `list` (its first copy, swapping the last into its place); whether it
+/// was there.
+fn remove(list: &mut Vec<u32>, v: u32) -> bool {
+    match list.iter().position(|&w| w == v) {
+        Some(i) => {
+            list.swap_remove(i);
+            true
+        }
         None => false,
     }
 }
@@ -1820,7 +1906,10 @@ type Cell = (i32, i32, i32);
 /// Points bucketed by cubic cells.
 struct PointGrid {
     inv: f64,
-    cells: HashMap<Cell, Vec<u32>, FastHash>,
+    /// The index in `cells` of each cell that holds a point.
+    index: HashMap<Cell, u32, FastHash>,
+    /// The cells that hold points, with their points.
+    cells: Vec<(Cell, Vec<u32>)>,
 }
 
 fn cell_of(inv: f64, p: [f64; 3]) -> Cell {
@@ -1832,13 +1921,22 @@ impl PointGrid {
     fn new(cell: f64) -> Self {
         PointGrid {
             inv: 1.0 / cell,
-            cells: HashMap::default(),
+            index: HashMap::default(),
+            cells: Vec::new(),
         }
     }
     fn insert(&mut self, v: u32, p: [f64; 3]) {
-        self.cells.entry(cell_of(self.inv, p)).or_default().push(v);
+        let cell = cell_of(self.inv, p);
+        let next = self.cells.len() as u32;
+        let i = *self.index.entry(cell).or_insert(next);
+        if i == next {
+            self.cells.push((cell, Vec::new()));
+        }
+        self.cells[i as usize].1.push(v);
     }
-    /// Calls `f` for every point whose cell meets the box of radius `r` about `p`.
+    /// Calls `f` for every point within distance `r` of `p`, and for some others near it
+    /// (those whose cells meet the box of radius `r` about `p`, and maybe those of the cells
+    /// next to it), in no particular order.
     fn near(&self, p: [f64; 3], r: f64, mut f: impl FnMut(u32)) {
         let lo = cell_of(self.inv, p.map(|x| x - r));
         let hi = cell_of(self.inv, p.map(|x| x + r));
@@ -1846,16 +1944,22 @@ impl PointGrid {
             * (i64::from(hi.1) - i64::from(lo.1) + 1)
             * (i64::from(hi.2) - i64::from(lo.2) + 1);
         if count > self.cells.len() as i64 {
-            for list in self.cells.values() {
-                list.iter().for_each(|&v| f(v));
+            // Fewer cells hold points than the box covers: those cells are scanned instead.
+            // A cell two or more beyond the box on some axis is a whole cell farther than `r`
+            // from `p`, far beyond any rounding, so none of its points is within `r`.
+            let within = |c: i32, lo: i32, hi: i32| lo - 1 <= c && c <= hi + 1;
+            for (c, list) in &self.cells {
+                if within(c.0, lo.0, hi.0) && within(c.1, lo.1, hi.1) && within(c.2, lo.2, hi.2) {
+                    list.iter().for_each(|&v| f(v));
+                }
             }
             return;
         }
         for x in lo.0..=hi.0 {
             for y in lo.1..=hi.1 {
                 for z in lo.2..=hi.2 {
-                    if let Some(list) = self.cells.get(&(x, y, z)) {
-                        list.iter().for_each(|&v| f(v));
+                    if let Some(&i) = self.index.get(&(x, y, z)) {
+                        self.cells[i as usize].1.iter().for_each(|&v| f(v));
                     }
                 }
             }
@@ -1864,21 +1968,69 @@ impl PointGrid {
 }
 
 /// Triangles bucketed by the cells their bounding boxes meet.
+///
+/// The chart's triangles are filed once, in compressed rows by cell (no list per cell to
+/// grow); triangles added later go to lists of their own, by row.
 struct FaceGrid {
     inv: f64,
-    cells: HashMap<Cell, Vec<u32>, FastHash>,
+    /// The row of each cell that holds a triangle.
+    rows: HashMap<Cell, u32, FastHash>,
+    /// The chart's triangles of row `r` are `filed[start[r]..start[r + 1]]`.
+    start: Vec<u32>,
+    filed: Vec<u32>,
+    /// Triangles added later, by row.
+    later: Vec<Vec<u32>>,
     /// Triangles too large to file cell by cell: tested against every query.
     large: Vec<u32>,
 }
 
 impl FaceGrid {
-    /// A grid of cells of side `cell` with room for about `faces` triangles.
-    fn new(cell: f64, faces: usize) -> Self {
-        FaceGrid {
+    /// A grid of cells of side `cell` holding the triangles `tris` of the points `pos`.
+    fn new(cell: f64, pos: &[[f64; 3]], tris: &[[u32; 3]]) -> Self {
+        let mut grid = FaceGrid {
             inv: 1.0 / cell,
-            cells: HashMap::with_capacity_and_hasher(faces, FastHash::default()),
+            rows: HashMap::default(),
+            start: Vec::new(),
+            filed: Vec::new(),
+            later: Vec::new(),
             large: Vec::new(),
+        };
+        // (row, triangle) for each cell a triangle's box meets, then grouped by row.
+        let mut entries: Vec<(u32, u32)> = Vec::with_capacity(3 * tris.len());
+        for (f, t) in tris.iter().enumerate() {
+            let (lo, hi, count) = grid.range(&corners(pos, *t));
+            if count > 64 {
+                grid.large.push(f as u32);
+                continue;
+            }
+            for x in lo.0..=hi.0 {
+                for y in lo.1..=hi.1 {
+                    for z in lo.2..=hi.2 {
+                        let next = grid.rows.len() as u32;
+                        let row = *grid.rows.entry((x, y, z)).or_insert(next);
+                        entries.push((row, f as u32));
+                    }
+                }
+            }
         }
+        let rows = grid.rows.len();
+        let mut start = vec![0u32; rows + 1];
+        for &(r, _) in &entries {
+            start[r as usize + 1] += 1;
+        }
+        for r in 0..rows {
+            start[r + 1] += start[r];
+        }
+        let mut fill = start.clone();
+        let mut filed = vec![0u32; entries.len()];
+        for &(r, f) in &entries {
+            filed[fill[r as usize] as usize] = f;
+            fill[r as usize] += 1;
+        }
+        grid.start = start;
+        grid.filed = filed;
+        grid.later = vec![Vec::new(); rows];
+        grid
     }
     fn range(&self, c: &[[f64; 3]; 3]) -> (Cell, Cell, i64) {
         let lo = [0, 1, 2].map(|k| c[0][k].min(c[1][k]).min(c[2][k]));
@@ -1898,26 +2050,37 @@ impl FaceGrid {
         for x in lo.0..=hi.0 {
             for y in lo.1..=hi.1 {
                 for z in lo.2..=hi.2 {
-                    self.cells.entry((x, y, z)).or_default().push(f);
+                    let row = match self.rows.entry((x, y, z)) {
+                        std::collections::hash_map::Entry::Occupied(e) => *e.get(),
+                        std::collections::hash_map::Entry::Vacant(e) => {
+                            // A new row, with none of the chart's triangles.
+                            self.start.push(self.filed.len() as u32);
+                            self.later.push(Vec::new());
+                            *e.insert(self.later.len() as u32 - 1)
+                        }
+                    };
+                    self.later[row as usize].push(f);
                 }
             }
         }
     }
-    /// Calls `f` for every triangle filed in a cell the box of `c` meets (maybe repeatedly).
+    /// Calls `f` for every triangle filed in a cell the box of `c` meets (maybe repeatedly,
+    /// in no particular order).
     fn near(&self, c: &[[f64; 3]; 3], mut f: impl FnMut(u32)) {
         let (lo, hi, count) = self.range(c);
         self.large.iter().for_each(|&t| f(t));
         if count > 4096 {
-            for list in self.cells.values() {
-                list.iter().for_each(|&t| f(t));
-            }
+            self.filed.iter().for_each(|&t| f(t));
+            self.later.iter().flatten().for_each(|&t| f(t));
             return;
         }
         for x in lo.0..=hi.0 {
             for y in lo.1..=hi.1 {
                 for z in lo.2..=hi.2 {
-                    if let Some(list) = self.cells.get(&(x, y, z)) {
-                        list.iter().for_each(|&t| f(t));
+                    if let Some(&r) = self.rows.get(&(x, y, z)) {
+                        let r = r as usize;
+                        let chart = &self.filed[self.start[r] as usize..self.start[r + 1] as usize];
+                        chart.iter().chain(&self.later[r]).for_each(|&t| f(t));
                     }
                 }
             }
