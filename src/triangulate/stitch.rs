@@ -286,8 +286,11 @@ pub(crate) fn stitch<T: Scalar, F: NormalField<T>>(
         let edges: Vec<(u32, u32)> = match &opened {
             None => s.boundary_edge_list(),
             Some(near) => {
-                s.rejected
-                    .retain(|(a, b, _)| !near.contains(a) && !near.contains(b));
+                for (&(a, b), memo) in &mut s.memos {
+                    if near.contains(&a) || near.contains(&b) {
+                        memo.rejected.clear();
+                    }
+                }
                 s.boundary_edge_list()
                     .into_iter()
                     .filter(|(a, b)| near.contains(a) || near.contains(b))
@@ -299,7 +302,7 @@ pub(crate) fn stitch<T: Scalar, F: NormalField<T>>(
         }
         let mut steps = 0;
         while let Some(c) = s.heap.pop() {
-            if s.version.get(&(c.a, c.b)) != Some(&c.version) {
+            if s.memos.get(&(c.a, c.b)).map(|m| m.version) != Some(c.version) {
                 continue;
             }
             if steps == budget {
@@ -328,7 +331,10 @@ pub(crate) fn stitch<T: Scalar, F: NormalField<T>>(
                     if c.x == NEW && x.is_some() {
                         s.retract();
                     }
-                    s.rejected.insert((c.a, c.b, c.x));
+                    let rejected = &mut s.memos.entry((c.a, c.b)).or_default().rejected;
+                    if !rejected.contains(&c.x) {
+                        rejected.push(c.x);
+                    }
                     s.refresh(c.a, c.b);
                 }
             }
@@ -389,6 +395,22 @@ pub(crate) fn stitch<T: Scalar, F: NormalField<T>>(
 /// A remembered score: the epochs of its vertices, the bits of its reach, the score.
 type RememberedScore = ([u32; 3], u64, Option<f64>);
 
+/// What [`Stitcher::refresh`] keeps of an edge from one call to the next.
+#[derive(Default)]
+struct EdgeMemo {
+    /// How many times the edge was refreshed: a queued candidate is current only while it
+    /// carries the latest count.
+    version: u32,
+    /// The candidates (vertices, or [`NEW`]) the edge's triangle failed with.
+    rejected: Vec<u32>,
+    /// The nearest points within reach of the edge (see [`Stitcher::nearest`]), and the
+    /// number of points in the grid and the bits of the reach they were found for.
+    nearest: Vec<(f64, u32)>,
+    nearest_for: Option<(usize, u64)>,
+    /// Scores by candidate, sorted (see [`Stitcher::refresh_score`]).
+    scores: Vec<(u32, RememberedScore)>,
+}
+
 /// A new point proposed for an edge, before it is committed.
 #[derive(Clone)]
 struct Proposal<T> {
@@ -425,11 +447,9 @@ struct Stitcher<'a, 'f, T, F> {
     faces: FaceGrid,
     /// Each edge's new point, once proposed (`None`: there is none).
     proposals: EdgeMap<Option<Proposal<T>>>,
-    rejected: HashSet<(u32, u32, u32), FastHash>,
-    version: EdgeMap<u32>,
+    /// What [`Self::refresh`] keeps of each edge it looked at.
+    memos: EdgeMap<EdgeMemo>,
     heap: BinaryHeap<Candidate>,
-    /// Scratch list of [`Self::refresh`]'s candidates (kept to spare an allocation a call).
-    found: Vec<(f64, u32)>,
     /// Whether [`Self::in_open_wedge`] remembers its angles in `wedge_angles` (only during a
     /// [`Self::refresh`], when no vertex moves or comes and goes).
     wedge_memo: std::cell::Cell<bool>,
@@ -438,9 +458,6 @@ struct Stitcher<'a, 'f, T, F> {
     /// A count per vertex of the changes to the edges and boundary edges at it (see
     /// [`Self::touch`]).
     epoch: Vec<u32>,
-    /// [`Self::refresh`]'s scores by candidate `(a, b, x)`, with the epochs of `a`, `b`, `x`
-    /// and the bits of the reach they were computed for.
-    scores: HashMap<(u32, u32, u32), RememberedScore, FastHash>,
 }
 
 impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
@@ -526,14 +543,11 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
             points,
             faces,
             proposals: HashMap::default(),
-            rejected: HashSet::default(),
-            version: HashMap::default(),
+            memos: HashMap::default(),
             heap: BinaryHeap::new(),
-            found: Vec::new(),
             wedge_memo: std::cell::Cell::new(false),
             wedge_angles: std::cell::RefCell::new(HashMap::default()),
             epoch: Vec::new(),
-            scores: HashMap::default(),
         }
     }
 
@@ -574,23 +588,70 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
 
     /// Finds the best candidate for the boundary edge `a → b` and queues it.
     fn refresh(&mut self, a: u32, b: u32) {
-        let version = {
-            let v = self.version.entry((a, b)).or_insert(0);
-            *v += 1;
-            *v
-        };
-        if !self.is_boundary_edge(a, b) {
-            return;
+        // (Taken out of the table while the candidates are scored.)
+        let mut memo = self.memos.remove(&(a, b)).unwrap_or_default();
+        memo.version += 1;
+        if self.is_boundary_edge(a, b) {
+            if let Some((score, x)) = self.best_candidate(a, b, &mut memo) {
+                self.heap.push(Candidate {
+                    score,
+                    a,
+                    b,
+                    x,
+                    version: memo.version,
+                });
+            }
         }
-        let (pa, pb) = (self.pos[a as usize], self.pos[b as usize]);
+        self.memos.insert((a, b), memo);
+    }
+
+    /// The best candidate for the boundary edge `a → b` and its score, if any.
+    fn best_candidate(&self, a: u32, b: u32, memo: &mut EdgeMemo) -> Option<(f64, u32)> {
         let reach = REACH * self.edge_scale(a, b);
-        let mid = [0, 1, 2].map(|k| 0.5 * (pa[k] + pb[k]));
+        // The grid only gains points, and points never move: the same number of points and
+        // the same reach find the same ones.
+        let nearest_for = (self.points.len(), reach.to_bits());
+        if memo.nearest_for != Some(nearest_for) {
+            self.nearest(a, b, reach, &mut memo.nearest);
+            memo.nearest_for = Some(nearest_for);
+        }
         let mut best: Option<(f64, u32)> = None;
-        // The nearest boundary vertices within reach, a bounded number of them: the work
-        // per edge stays constant where boundary vertices crowd.
-        self.wedge_angles.get_mut().clear();
+        self.wedge_angles.borrow_mut().clear();
         self.wedge_memo.set(true);
-        let mut found = std::mem::take(&mut self.found);
+        for &(_, x) in &memo.nearest {
+            if !self.on_boundary(x) || memo.rejected.contains(&x) {
+                continue;
+            }
+            // A score is 4 per glued edge plus the smallest angle (below 3.5): a candidate
+            // with less glue than the best so far cannot beat it (a tie keeps the best) and
+            // is not scored.
+            if best.is_some_and(|(s, _)| 4.0 * f64::from(self.glue(a, b, x)) + MAX_MIN_ANGLE <= s) {
+                continue;
+            }
+            if let Some(score) = self.refresh_score(a, b, x, reach, &mut memo.scores) {
+                if best.is_none_or(|(s, _)| score > s) {
+                    best = Some((score, x));
+                }
+            }
+        }
+        self.wedge_memo.set(false);
+        // A new point in front of the edge, if no existing vertex makes a good enough
+        // triangle there.
+        if best.is_none_or(|(s, _)| s < NEW_POINT_SCORE)
+            && self.may_grow(a, b)
+            && !memo.rejected.contains(&NEW)
+        {
+            best = Some((NEW_POINT_SCORE - 1e-9, NEW));
+        }
+        best
+    }
+
+    /// The nearest points of the grid within `reach` of the middle of edge `a → b` other
+    /// than `a` and `b`, a bounded number of them (the work per edge stays constant where
+    /// boundary vertices crowd), into `found` as (distance, vertex), nearest first.
+    fn nearest(&self, a: u32, b: u32, reach: f64, found: &mut Vec<(f64, u32)>) {
+        let (pa, pb) = (self.pos[a as usize], self.pos[b as usize]);
+        let mid = [0, 1, 2].map(|k| 0.5 * (pa[k] + pb[k]));
         found.clear();
         self.points.near(mid, reach, |x| {
             if x != a && x != b {
@@ -606,58 +667,38 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
             found.truncate(MAX_CANDIDATES);
         }
         found.sort_unstable_by(order);
-        for &(_, x) in &found {
-            if !self.on_boundary(x) || self.rejected.contains(&(a, b, x)) {
-                continue;
-            }
-            // A score is 4 per glued edge plus the smallest angle (below 3.5): a candidate
-            // with less glue than the best so far cannot beat it (a tie keeps the best) and
-            // is not scored.
-            if best.is_some_and(|(s, _)| 4.0 * f64::from(self.glue(a, b, x)) + MAX_MIN_ANGLE <= s) {
-                continue;
-            }
-            if let Some(score) = self.refresh_score(a, b, x, reach) {
-                if best.is_none_or(|(s, _)| score > s) {
-                    best = Some((score, x));
-                }
-            }
-        }
-        self.found = found;
-        self.wedge_memo.set(false);
-        // A new point in front of the edge, if no existing vertex makes a good enough
-        // triangle there.
-        if best.is_none_or(|(s, _)| s < NEW_POINT_SCORE)
-            && self.may_grow(a, b)
-            && !self.rejected.contains(&(a, b, NEW))
-        {
-            best = Some((NEW_POINT_SCORE - 1e-9, NEW));
-        }
-        if let Some((score, x)) = best {
-            self.heap.push(Candidate {
-                score,
-                a,
-                b,
-                x,
-                version,
-            });
-        }
     }
 
-    /// [`Self::score`] with the refresh's angle floor, remembered: a score reads the
-    /// positions, normals and provenance of `a`, `b`, `x` (which do not change once a vertex
-    /// is registered), the reach, and the edges and boundary edges at `a`, `b` and `x` (each
-    /// change to those bumps the vertex's epoch). So a remembered score with the same epochs
-    /// and reach is the score computed anew.
-    fn refresh_score(&mut self, a: u32, b: u32, x: u32, reach: f64) -> Option<f64> {
+    /// [`Self::score`] with the refresh's angle floor, remembered in `scores` (the edge's,
+    /// by `x`): a score reads the positions, normals and provenance of `a`, `b`, `x` (which
+    /// do not change once a vertex is registered), the reach, and the edges and boundary
+    /// edges at `a`, `b` and `x` (each change to those bumps the vertex's epoch). So a
+    /// remembered score with the same epochs and reach is the score computed anew.
+    fn refresh_score(
+        &self,
+        a: u32,
+        b: u32,
+        x: u32,
+        reach: f64,
+        scores: &mut Vec<(u32, RememberedScore)>,
+    ) -> Option<f64> {
         let epochs = [a, b, x].map(|v| self.epoch.get(v as usize).copied().unwrap_or(0));
-        if let Some(&(e, r, score)) = self.scores.get(&(a, b, x)) {
-            if e == epochs && r == reach.to_bits() {
-                return score;
+        let remembered = (epochs, reach.to_bits(), None);
+        let i = match scores.binary_search_by_key(&x, |e| e.0) {
+            Ok(i) => {
+                let (e, r, score) = scores[i].1;
+                if (e, r) == (remembered.0, remembered.1) {
+                    return score;
+                }
+                i
             }
-        }
+            Err(i) => {
+                scores.insert(i, (x, remembered));
+                i
+            }
+        };
         let score = self.score(a, b, x, reach, MIN_ANGLE_DEG.to_radians());
-        self.scores
-            .insert((a, b, x), (epochs, reach.to_bits(), score));
+        scores[i].1 = (epochs, reach.to_bits(), score);
         score
     }
 
@@ -1903,9 +1944,11 @@ fn pinched_fans(triangles: &[[u32; 3]], candidate: impl Fn(u32) -> bool) -> (Vec
 
 type Cell = (i32, i32, i32);
 
-/// Points bucketed by cubic cells.
+/// Points bucketed by cubic cells (points are only ever added).
 struct PointGrid {
     inv: f64,
+    /// How many points it holds.
+    len: usize,
     /// The index in `cells` of each cell that holds a point.
     index: HashMap<Cell, u32, FastHash>,
     /// The cells that hold points, with their points.
@@ -1921,11 +1964,16 @@ impl PointGrid {
     fn new(cell: f64) -> Self {
         PointGrid {
             inv: 1.0 / cell,
+            len: 0,
             index: HashMap::default(),
             cells: Vec::new(),
         }
     }
+    fn len(&self) -> usize {
+        self.len
+    }
     fn insert(&mut self, v: u32, p: [f64; 3]) {
+        self.len += 1;
         let cell = cell_of(self.inv, p);
         let next = self.cells.len() as u32;
         let i = *self.index.entry(cell).or_insert(next);
