@@ -69,6 +69,10 @@ const NEW_POINT_TURN_COS: f64 = std::f64::consts::FRAC_1_SQRT_2;
 const EAR_CLEARANCE: f64 = 0.02;
 /// Candidates examined per boundary edge: the nearest ones.
 const MAX_CANDIDATES: usize = 24;
+/// An edge's nearest points are searched for afresh, rather than updated with the points
+/// filed since they were found, once more than this many were (a search visits about as
+/// many).
+const TOP_UP: usize = 48;
 /// Smallest angle of a stitched triangle, degrees.
 pub(crate) const MIN_ANGLE_DEG: f64 = 12.0;
 /// Largest angle between a stitched triangle's normal and its corners' mean field normal,
@@ -403,8 +407,8 @@ struct EdgeMemo {
     version: u32,
     /// The candidates (vertices, or [`NEW`]) the edge's triangle failed with.
     rejected: Vec<u32>,
-    /// The nearest points within reach of the edge (see [`Stitcher::nearest`]), and the
-    /// number of points in the grid and the bits of the reach they were found for.
+    /// The nearest points within reach of the edge (see [`Stitcher::update_nearest`]), and
+    /// the number of points in the grid and the bits of the reach they were found for.
     nearest: Vec<(f64, u32)>,
     nearest_for: Option<(usize, u64)>,
     /// Scores by candidate, sorted (see [`Stitcher::refresh_score`]).
@@ -608,13 +612,7 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
     /// The best candidate for the boundary edge `a → b` and its score, if any.
     fn best_candidate(&self, a: u32, b: u32, memo: &mut EdgeMemo) -> Option<(f64, u32)> {
         let reach = REACH * self.edge_scale(a, b);
-        // The grid only gains points, and points never move: the same number of points and
-        // the same reach find the same ones.
-        let nearest_for = (self.points.len(), reach.to_bits());
-        if memo.nearest_for != Some(nearest_for) {
-            self.nearest(a, b, reach, &mut memo.nearest);
-            memo.nearest_for = Some(nearest_for);
-        }
+        self.update_nearest(a, b, reach, memo);
         let mut best: Option<(f64, u32)> = None;
         self.wedge_angles.borrow_mut().clear();
         self.wedge_memo.set(true);
@@ -646,21 +644,44 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
         best
     }
 
-    /// The nearest points of the grid within `reach` of the middle of edge `a → b` other
-    /// than `a` and `b`, a bounded number of them (the work per edge stays constant where
-    /// boundary vertices crowd), into `found` as (distance, vertex), nearest first.
-    fn nearest(&self, a: u32, b: u32, reach: f64, found: &mut Vec<(f64, u32)>) {
+    /// Sets `memo.nearest` to the nearest points of the grid within `reach` of the middle of
+    /// edge `a → b` other than `a` and `b`, a bounded number of them (the work per edge stays
+    /// constant where boundary vertices crowd), as (distance, vertex), nearest first.
+    fn update_nearest(&self, a: u32, b: u32, reach: f64, memo: &mut EdgeMemo) {
+        let filed = self.points.len();
         let (pa, pb) = (self.pos[a as usize], self.pos[b as usize]);
         let mid = [0, 1, 2].map(|k| 0.5 * (pa[k] + pb[k]));
-        found.clear();
-        self.points.near(mid, reach, |x| {
+        // The grid only gains points, and points never move: the nearest of the points filed
+        // before are among those found then, so only the points filed since are added to
+        // them (while they are few).
+        let before = memo
+            .nearest_for
+            .filter(|&(before, bits)| bits == reach.to_bits() && filed - before <= TOP_UP)
+            .map(|(before, _)| before);
+        if before == Some(filed) {
+            return;
+        }
+        memo.nearest_for = Some((filed, reach.to_bits()));
+        let found = &mut memo.nearest;
+        if before.is_none() {
+            found.clear();
+        }
+        let mut consider = |x: u32| {
             if x != a && x != b {
                 let d = dist(self.pos[x as usize], mid);
                 if d <= reach {
                     found.push((d, x));
                 }
             }
-        });
+        };
+        match before {
+            Some(before) => self
+                .points
+                .filed_since(before)
+                .iter()
+                .for_each(|&x| consider(x)),
+            None => self.points.near(mid, reach, consider),
+        }
         let order = |p: &(f64, u32), q: &(f64, u32)| p.0.total_cmp(&q.0).then(p.1.cmp(&q.1));
         if found.len() > MAX_CANDIDATES {
             found.select_nth_unstable_by(MAX_CANDIDATES, order);
@@ -1947,8 +1968,8 @@ type Cell = (i32, i32, i32);
 /// Points bucketed by cubic cells (points are only ever added).
 struct PointGrid {
     inv: f64,
-    /// How many points it holds.
-    len: usize,
+    /// The points, in the order they were filed.
+    filed: Vec<u32>,
     /// The index in `cells` of each cell that holds a point.
     index: HashMap<Cell, u32, FastHash>,
     /// The cells that hold points, with their points.
@@ -1964,16 +1985,21 @@ impl PointGrid {
     fn new(cell: f64) -> Self {
         PointGrid {
             inv: 1.0 / cell,
-            len: 0,
+            filed: Vec::new(),
             index: HashMap::default(),
             cells: Vec::new(),
         }
     }
+    /// How many points it holds.
     fn len(&self) -> usize {
-        self.len
+        self.filed.len()
+    }
+    /// The points filed after the first `n`.
+    fn filed_since(&self, n: usize) -> &[u32] {
+        &self.filed[n..]
     }
     fn insert(&mut self, v: u32, p: [f64; 3]) {
-        self.len += 1;
+        self.filed.push(v);
         let cell = cell_of(self.inv, p);
         let next = self.cells.len() as u32;
         let i = *self.index.entry(cell).or_insert(next);
