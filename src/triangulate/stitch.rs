@@ -614,7 +614,6 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
         let reach = REACH * self.edge_scale(a, b);
         self.update_nearest(a, b, reach, memo);
         let mut best: Option<(f64, u32)> = None;
-        self.wedge_angles.borrow_mut().clear();
         self.wedge_memo.set(true);
         for &(_, x) in &memo.nearest {
             if !self.on_boundary(x) || memo.rejected.contains(&x) {
@@ -999,7 +998,10 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
     /// other boundary edge of `v` between.
     ///
     /// During [`Self::refresh`] the angles about `v` are remembered (its candidates share
-    /// their edge's ends and the ends' boundary neighbours): the same value as computed anew.
+    /// their edge's ends and the ends' boundary neighbours, and edges near each other share
+    /// candidates): the same value as computed anew, since an angle reads only the positions
+    /// and normals of its two vertices, which do not change once a vertex is registered, and
+    /// no vertex is on trial during a refresh.
     fn in_open_wedge(&self, v: u32, from: u32, to: u32) -> bool {
         let (outs, ins) = (&self.bout[v as usize], &self.bin[v as usize]);
         let p = self.pos[v as usize];
