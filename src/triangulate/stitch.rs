@@ -99,22 +99,23 @@ type EdgeMap<V> = HashMap<(u32, u32), V, FastHash>;
 
 /// The directed edges of the triangles, as a set.
 ///
-/// The chart's edges are filed once in compressed rows by source (no hashing), each with a
-/// flag that says whether it is still there; edges the chart did not have are kept in lists
-/// by source.
+/// The chart's edges are filed once in compressed rows by source (no hashing), a removed one
+/// overwritten by [`GONE`]; edges added later are kept in lists by source.
 struct EdgeSet {
     /// The targets of the chart's edges from `u` are `targets[start[u]..start[u + 1]]`.
     start: Vec<u32>,
     targets: Vec<u32>,
-    /// Whether each of `targets` is still an edge.
-    present: Vec<bool>,
     /// The targets of the other edges, by source (empty beyond its length).
     added: Vec<Vec<u32>>,
 }
 
+/// A chart edge's target once the edge is removed (no vertex has this id).
+const GONE: u32 = u32::MAX;
+
 impl EdgeSet {
     /// The edges of `tris`, whose corners are below `vertices`.
     fn new(vertices: usize, tris: &[[u32; 3]]) -> Self {
+        // Counts, summed into the ends of the rows, then each row filled from its end.
         let mut start = vec![0u32; vertices + 1];
         for t in tris {
             for &u in t {
@@ -124,62 +125,196 @@ impl EdgeSet {
         for v in 0..vertices {
             start[v + 1] += start[v];
         }
-        let mut fill = start.clone();
         let mut targets = vec![0u32; 3 * tris.len()];
         for t in tris {
             for k in 0..3 {
-                let u = t[k] as usize;
-                targets[fill[u] as usize] = t[(k + 1) % 3];
-                fill[u] += 1;
+                let end = &mut start[t[k] as usize + 1];
+                *end -= 1;
+                targets[*end as usize] = t[(k + 1) % 3];
             }
         }
+        // Each row's end has come down to its start: row `u` begins at `start[u + 1]`.
+        start.copy_within(1.., 0);
+        start[vertices] = targets.len() as u32;
         EdgeSet {
             start,
-            present: vec![true; targets.len()],
             targets,
             added: Vec::new(),
         }
     }
 
-    /// The positions in `targets` of the chart's edges from `u`.
-    fn chart_row(&self, u: u32) -> std::ops::Range<usize> {
+    /// The chart's edges from `u`, by target.
+    fn chart_row(&self, u: u32) -> &[u32] {
         let u = u as usize;
         match (self.start.get(u), self.start.get(u + 1)) {
-            (Some(&s), Some(&e)) => s as usize..e as usize,
-            _ => 0..0,
+            (Some(&s), Some(&e)) => &self.targets[s as usize..e as usize],
+            _ => &[],
         }
     }
 
     fn contains(&self, u: u32, v: u32) -> bool {
-        self.chart_row(u)
-            .any(|i| self.targets[i] == v && self.present[i])
-            || self.added.get(u as usize).is_some_and(|l| l.contains(&v))
+        self.chart_row(u).contains(&v) || self.added.get(u as usize).is_some_and(|l| l.contains(&v))
     }
 
     fn insert(&mut self, u: u32, v: u32) {
-        if let Some(i) = self.chart_row(u).find(|&i| self.targets[i] == v) {
-            self.present[i] = true;
+        if self.contains(u, v) {
             return;
         }
         let u = u as usize;
         if u >= self.added.len() {
             self.added.resize(u + 1, Vec::new());
         }
-        if !self.added[u].contains(&v) {
-            self.added[u].push(v);
-        }
+        self.added[u].push(v);
     }
 
     fn remove(&mut self, u: u32, v: u32) {
-        // (Every copy, should the chart list an edge twice.)
-        for i in self.chart_row(u) {
-            if self.targets[i] == v {
-                self.present[i] = false;
+        let u = u as usize;
+        if let (Some(&s), Some(&e)) = (self.start.get(u), self.start.get(u + 1)) {
+            // (Every copy, should the chart list an edge twice.)
+            for t in &mut self.targets[s as usize..e as usize] {
+                if *t == v {
+                    *t = GONE;
+                }
             }
         }
-        if let Some(l) = self.added.get_mut(u as usize) {
+        if let Some(l) = self.added.get_mut(u) {
             l.retain(|&w| w != v);
         }
+    }
+}
+
+/// The boundary edges at each vertex and the vertices' local scales, kept for the vertices
+/// that have been on the boundary (a few thousand of a mesh's vertices): a slot per vertex
+/// and a record per boundary vertex.
+struct Boundary {
+    /// Each vertex's index in `records`, or [`NO_RECORD`].
+    slot: Vec<u32>,
+    records: Vec<BoundaryVertex>,
+}
+
+/// The slot of a vertex without a record (out of bounds of any `records`).
+const NO_RECORD: u32 = u32::MAX;
+
+struct BoundaryVertex {
+    vertex: u32,
+    /// The targets of the boundary edges from the vertex.
+    outs: Vec<u32>,
+    /// The sources of the boundary edges into the vertex.
+    ins: Vec<u32>,
+    /// Mean length of the edges at the vertex (at the start, or when added); `None` until
+    /// set.
+    scale: Option<f64>,
+}
+
+impl Boundary {
+    /// No boundary edges on `vertices` vertices.
+    fn new(vertices: usize) -> Self {
+        Boundary {
+            slot: vec![NO_RECORD; vertices],
+            records: Vec::new(),
+        }
+    }
+
+    fn record(&self, v: u32) -> Option<&BoundaryVertex> {
+        self.records.get(self.slot[v as usize] as usize)
+    }
+
+    fn record_mut(&mut self, v: u32) -> &mut BoundaryVertex {
+        let slot = &mut self.slot[v as usize];
+        if *slot == NO_RECORD {
+            *slot = self.records.len() as u32;
+            self.records.push(BoundaryVertex {
+                vertex: v,
+                outs: Vec::new(),
+                ins: Vec::new(),
+                scale: None,
+            });
+        }
+        &mut self.records[*slot as usize]
+    }
+
+    /// The targets of the boundary edges from `v`.
+    fn outs(&self, v: u32) -> &[u32] {
+        self.record(v).map_or(&[], |r| &r.outs)
+    }
+
+    /// The sources of the boundary edges into `v`.
+    fn ins(&self, v: u32) -> &[u32] {
+        self.record(v).map_or(&[], |r| &r.ins)
+    }
+
+    fn scale(&self, v: u32) -> Option<f64> {
+        self.record(v).and_then(|r| r.scale)
+    }
+
+    fn set_scale(&mut self, v: u32, h: f64) {
+        self.record_mut(v).scale = Some(h);
+    }
+
+    /// Sets each boundary vertex's scale to the mean length of the edges at it, those of
+    /// triangles `tris` of points `pos`.
+    fn set_mean_scales(&mut self, pos: &[[f64; 3]], tris: &[[u32; 3]]) {
+        let mut sums = vec![(0.0, 0u32); self.records.len()];
+        for t in tris {
+            for k in 0..3 {
+                let (a, b) = (t[k] as usize, t[(k + 1) % 3] as usize);
+                if self.slot[a] == NO_RECORD && self.slot[b] == NO_RECORD {
+                    continue;
+                }
+                let l = dist(pos[a], pos[b]);
+                for v in [a, b] {
+                    if let Some(e) = sums.get_mut(self.slot[v] as usize) {
+                        e.0 += l;
+                        e.1 += 1;
+                    }
+                }
+            }
+        }
+        for (r, (sum, n)) in self.records.iter_mut().zip(sums) {
+            r.scale = Some(if n > 0 { sum / n as f64 } else { 0.0 });
+        }
+    }
+
+    /// Adds the boundary edge `a → b`.
+    fn insert(&mut self, a: u32, b: u32) {
+        self.record_mut(a).outs.push(b);
+        self.record_mut(b).ins.push(a);
+    }
+
+    /// Removes the boundary edge `a → b` (its first copy); whether it was there.
+    fn remove(&mut self, a: u32, b: u32) -> bool {
+        let Some(ra) = self.records.get_mut(self.slot[a as usize] as usize) else {
+            return false;
+        };
+        if !remove(&mut ra.outs, b) {
+            return false;
+        }
+        // (`ins` mirrors `outs`: every change to one is made to the other.)
+        let rb = &mut self.records[self.slot[b as usize] as usize];
+        remove(&mut rb.ins, a);
+        true
+    }
+
+    /// The boundary edges, in no particular order.
+    fn edges(&self) -> impl Iterator<Item = (u32, u32)> + '_ {
+        self.records
+            .iter()
+            .flat_map(|r| r.outs.iter().map(move |&b| (r.vertex, b)))
+    }
+
+    /// How many boundary edges there are.
+    fn edge_count(&self) -> usize {
+        self.records.iter().map(|r| r.outs.len()).sum()
+    }
+
+    /// Makes room for a new vertex (with no record).
+    fn push_vertex(&mut self) {
+        self.slot.push(NO_RECORD);
+    }
+
+    /// Takes the last vertex back (a vertex on trial, which has no record).
+    fn pop_vertex(&mut self) {
+        self.slot.pop();
     }
 }
 
@@ -438,13 +573,8 @@ struct Stitcher<'a, 'f, T, F> {
     initial: usize,
     /// The triangles' directed edges.
     edges: EdgeSet,
-    /// Boundary edges by vertex: `bout[a]` the targets of those from `a`, `bin[b]` the
-    /// sources of those into `b` (like `scale`, one entry per vertex).
-    bout: Vec<Vec<u32>>,
-    bin: Vec<Vec<u32>>,
-    /// Mean length of the edges at each boundary vertex (at the start, or when added); `None`
-    /// for vertices that have not been on the boundary.
-    scale: Vec<Option<f64>>,
+    /// The boundary edges and the local scales.
+    boundary: Boundary,
     /// Boundary vertices, for candidate searches.
     points: PointGrid,
     /// Triangles near the boundary, for the intersection tests.
@@ -477,44 +607,21 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
         let prov = std::mem::take(&mut mesh.provenance);
         let n = pos.len();
         let edges = EdgeSet::new(n, &tris);
-        let mut bout: Vec<Vec<u32>> = vec![Vec::new(); n];
-        let mut bin: Vec<Vec<u32>> = vec![Vec::new(); n];
+        let mut boundary = Boundary::new(n);
         for t in &tris {
             for k in 0..3 {
                 let (a, b) = (t[k], t[(k + 1) % 3]);
                 if !edges.contains(b, a) {
-                    bout[a as usize].push(b);
-                    bin[b as usize].push(a);
+                    boundary.insert(a, b);
                 }
             }
         }
         // Local scale: the mean length of the edges at each boundary vertex.
-        let mut sums: Vec<Option<(f64, u32)>> = (0..n)
-            .map(|v| (!bout[v].is_empty() || !bin[v].is_empty()).then_some((0.0, 0)))
-            .collect();
-        for t in &tris {
-            for k in 0..3 {
-                let (a, b) = (t[k] as usize, t[(k + 1) % 3] as usize);
-                if sums[a].is_none() && sums[b].is_none() {
-                    continue;
-                }
-                let l = dist(pos[a], pos[b]);
-                for v in [a, b] {
-                    if let Some(e) = &mut sums[v] {
-                        e.0 += l;
-                        e.1 += 1;
-                    }
-                }
-            }
-        }
-        let scale: Vec<Option<f64>> = sums
-            .into_iter()
-            .map(|e| e.map(|(sum, n)| if n > 0 { sum / n as f64 } else { 0.0 }))
-            .collect();
-        let mut lengths: Vec<f64> = scale
+        boundary.set_mean_scales(&pos, &tris);
+        let mut lengths: Vec<f64> = boundary
+            .records
             .iter()
-            .flatten()
-            .copied()
+            .filter_map(|r| r.scale)
             .filter(|l| *l > 0.0)
             .collect();
         lengths.sort_by(f64::total_cmp);
@@ -525,8 +632,8 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
             .max(1e-300)
             * REACH;
         let mut points = PointGrid::new(cell);
-        for v in (0..n).filter(|&v| scale[v].is_some()) {
-            points.insert(v as u32, pos[v]);
+        for v in (0..n as u32).filter(|&v| boundary.scale(v).is_some()) {
+            points.insert(v, pos[v as usize]);
         }
         let faces = FaceGrid::new(cell, &pos, &tris);
         let mut rim = rim.to_vec();
@@ -541,9 +648,7 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
             initial: tris.len(),
             tris,
             edges,
-            bout,
-            bin,
-            scale,
+            boundary,
             points,
             faces,
             proposals: HashMap::default(),
@@ -556,31 +661,26 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
     }
 
     fn boundary_edges(&self) -> usize {
-        self.bout.iter().map(Vec::len).sum()
+        self.boundary.edge_count()
     }
 
     /// The boundary edges in a deterministic order.
     fn boundary_edge_list(&self) -> Vec<(u32, u32)> {
-        let mut list: Vec<(u32, u32)> = self
-            .bout
-            .iter()
-            .enumerate()
-            .flat_map(|(a, bs)| bs.iter().map(move |&b| (a as u32, b)))
-            .collect();
+        let mut list: Vec<(u32, u32)> = self.boundary.edges().collect();
         list.sort_unstable();
         list
     }
 
     fn is_boundary_edge(&self, a: u32, b: u32) -> bool {
-        self.bout[a as usize].contains(&b)
+        self.boundary.outs(a).contains(&b)
     }
 
     fn on_boundary(&self, v: u32) -> bool {
-        !self.bout[v as usize].is_empty()
+        !self.boundary.outs(v).is_empty()
     }
 
     fn local(&self, v: u32) -> f64 {
-        self.scale[v as usize].unwrap_or(0.0)
+        self.boundary.scale(v).unwrap_or(0.0)
     }
 
     /// The length scale of edge `a → b`: its own length, or its ends' mean edge length if
@@ -771,9 +871,7 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
         });
         self.work.push(point);
         self.rim.push(Rim::Open);
-        self.bout.push(Vec::new());
-        self.bin.push(Vec::new());
-        self.scale.push(None);
+        self.boundary.push_vertex();
     }
 
     /// Takes back the vertex on trial.
@@ -784,16 +882,15 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
         self.prov.pop();
         self.work.pop();
         self.rim.pop();
-        self.bout.pop();
-        self.bin.pop();
-        self.scale.pop();
+        self.boundary.pop_vertex();
     }
 
     /// Keeps the vertex on trial `v`, placed for edge `a → b`.
     fn register(&mut self, v: u32, a: u32, b: u32) {
         self.proposals.remove(&(a, b));
         let h = 0.5 * (self.local(a) + self.local(b));
-        self.scale[v as usize] = Some(h.max(dist(self.pos[a as usize], self.pos[b as usize])));
+        let h = h.max(dist(self.pos[a as usize], self.pos[b as usize]));
+        self.boundary.set_scale(v, h);
         self.points.insert(v, self.pos[v as usize]);
     }
 
@@ -888,8 +985,8 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
     fn refresh_near(&mut self, a: u32, b: u32, x: u32) {
         let mut around = vec![a, b, x];
         for v in [a, b, x] {
-            around.extend(&self.bout[v as usize]);
-            around.extend(&self.bin[v as usize]);
+            around.extend(self.boundary.outs(v));
+            around.extend(self.boundary.ins(v));
         }
         // And the boundary vertices about as close to the triangle as its own size.
         let c = corners(&self.pos, [a, b, x]);
@@ -906,10 +1003,10 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
         around.dedup();
         let mut list = Vec::new();
         for v in around {
-            for &w in &self.bout[v as usize] {
+            for &w in self.boundary.outs(v) {
                 list.push((v, w));
             }
-            for &u in &self.bin[v as usize] {
+            for &u in self.boundary.ins(v) {
                 list.push((u, v));
             }
         }
@@ -1003,7 +1100,7 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
     /// and normals of its two vertices, which do not change once a vertex is registered, and
     /// no vertex is on trial during a refresh.
     fn in_open_wedge(&self, v: u32, from: u32, to: u32) -> bool {
-        let (outs, ins) = (&self.bout[v as usize], &self.bin[v as usize]);
+        let (outs, ins) = (self.boundary.outs(v), self.boundary.ins(v));
         let p = self.pos[v as usize];
         let n = self.nrm[v as usize];
         let (e1, e2) = tangent_frame(n);
@@ -1460,7 +1557,7 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
             return None;
         }
         for v in first_new..self.pos.len() as u32 {
-            self.scale[v as usize] = Some(mean_edge);
+            self.boundary.set_scale(v, mean_edge);
             self.points.insert(v, self.pos[v as usize]);
         }
         for &t in &triangles {
@@ -1576,7 +1673,7 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
                 return None;
             }
             ring.push(v);
-            match self.bout[v as usize].as_slice() {
+            match self.boundary.outs(v) {
                 [next] => v = *next,
                 _ => return None,
             }
@@ -1602,7 +1699,7 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
                 if ring.len() > REDO_HOLE {
                     ok = false;
                 }
-                let Some(&w) = self.bout[v as usize].first() else {
+                let Some(&w) = self.boundary.outs(v).first() else {
                     ok = false;
                     break;
                 };
@@ -1678,23 +1775,21 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
             self.edges.remove(u, v);
             if self.edges.contains(v, u) {
                 // Its twin is a boundary edge now.
-                self.bout[v as usize].push(u);
-                self.bin[u as usize].push(v);
+                self.boundary.insert(v, u);
             } else {
-                remove(&mut self.bout[u as usize], v);
-                remove(&mut self.bin[v as usize], u);
+                self.boundary.remove(u, v);
             }
         }
         for v in t {
-            if self.scale[v as usize].is_none() {
+            if self.boundary.scale(v).is_none() {
                 self.points.insert(v, self.pos[v as usize]);
             }
             // The new boundary's scale: the longest of its boundary edges.
             let mut h = self.local(v);
-            for &w in &self.bout[v as usize] {
+            for &w in self.boundary.outs(v) {
                 h = h.max(dist(self.pos[v as usize], self.pos[w as usize]));
             }
-            self.scale[v as usize] = Some(h);
+            self.boundary.set_scale(v, h);
         }
     }
 
@@ -1709,12 +1804,9 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
         for k in 0..3 {
             let (u, v) = (t[k], t[(k + 1) % 3]);
             self.edges.insert(u, v);
-            if remove(&mut self.bout[v as usize], u) {
-                // The twin `v → u` was a boundary edge: now both are inside.
-                remove(&mut self.bin[u as usize], v);
-            } else {
-                self.bout[u as usize].push(v);
-                self.bin[v as usize].push(u);
+            // If the twin `v → u` was a boundary edge, both are inside now.
+            if !self.boundary.remove(v, u) {
+                self.boundary.insert(u, v);
             }
         }
     }
