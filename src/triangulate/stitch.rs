@@ -531,8 +531,17 @@ pub(crate) fn stitch<T: Scalar, F: NormalField<T>>(
     out
 }
 
-/// A remembered score: the epochs of its vertices, the bits of its reach, the score.
-type RememberedScore = ([u32; 3], u64, Option<f64>);
+/// A candidate's remembered score (see [`Stitcher::refresh_score`]).
+#[derive(Clone, Copy)]
+struct RememberedScore {
+    /// The epochs of `a`, `b`, `x` the score was computed for.
+    epochs: [u32; 3],
+    /// The bits of the reach the score and the shape were computed for.
+    reach: u64,
+    score: Option<f64>,
+    /// The triangle's [`Stitcher::shape`].
+    shape: Option<[f64; 3]>,
+}
 
 /// What [`Stitcher::refresh`] keeps of an edge from one call to the next.
 #[derive(Default)]
@@ -793,7 +802,8 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
     /// by `x`): a score reads the positions, normals and provenance of `a`, `b`, `x` (which
     /// do not change once a vertex is registered), the reach, and the edges and boundary
     /// edges at `a`, `b` and `x` (each change to those bumps the vertex's epoch). So a
-    /// remembered score with the same epochs and reach is the score computed anew.
+    /// remembered score with the same epochs and reach is the score computed anew, and a
+    /// remembered shape with the same reach is the shape computed anew.
     fn refresh_score(
         &self,
         a: u32,
@@ -803,22 +813,28 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
         scores: &mut Vec<(u32, RememberedScore)>,
     ) -> Option<f64> {
         let epochs = [a, b, x].map(|v| self.epoch.get(v as usize).copied().unwrap_or(0));
-        let remembered = (epochs, reach.to_bits(), None);
-        let i = match scores.binary_search_by_key(&x, |e| e.0) {
-            Ok(i) => {
-                let (e, r, score) = scores[i].1;
-                if (e, r) == (remembered.0, remembered.1) {
-                    return score;
+        let floor = MIN_ANGLE_DEG.to_radians();
+        let found = scores.binary_search_by_key(&x, |e| e.0);
+        let shape = match found {
+            Ok(i) if scores[i].1.reach == reach.to_bits() => {
+                if scores[i].1.epochs == epochs {
+                    return scores[i].1.score;
                 }
-                i
+                scores[i].1.shape
             }
-            Err(i) => {
-                scores.insert(i, (x, remembered));
-                i
-            }
+            _ => self.shape(a, b, x, reach, floor),
         };
-        let score = self.score(a, b, x, reach, MIN_ANGLE_DEG.to_radians());
-        scores[i].1 = (epochs, reach.to_bits(), score);
+        let score = shape.and_then(|angles| self.fits(a, b, x, angles, floor));
+        let remembered = RememberedScore {
+            epochs,
+            reach: reach.to_bits(),
+            score,
+            shape,
+        };
+        match found {
+            Ok(i) => scores[i].1 = remembered,
+            Err(i) => scores.insert(i, (x, remembered)),
+        }
         score
     }
 
@@ -1020,13 +1036,16 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
     /// The score of triangle `(b, a, x)`, or `None` when it may not be added (all tests
     /// but the exact intersection test, which [`Self::acceptable`] runs when it comes up).
     fn score(&self, a: u32, b: u32, x: u32, reach: f64, min_floor: f64) -> Option<f64> {
+        let angles = self.shape(a, b, x, reach, min_floor)?;
+        self.fits(a, b, x, angles, min_floor)
+    }
+
+    /// The tests of [`Self::score`] that read only the corners' positions and normals and
+    /// the reach: the triangle's angles at `a`, `b`, `x` if it passes them.
+    fn shape(&self, a: u32, b: u32, x: u32, reach: f64, min_floor: f64) -> Option<[f64; 3]> {
         let [pa, pb, px] = [a, b, x].map(|v| self.pos[v as usize]);
         let nx = self.nrm[x as usize];
         if dist(pa, px) > reach || dist(pb, px) > reach {
-            return None;
-        }
-        // Each edge at most twice, once each way.
-        if self.edges.contains(a, x) || self.edges.contains(x, b) {
             return None;
         }
         let face = cross(sub(pa, pb), sub(px, pb));
@@ -1057,6 +1076,18 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
         if !sliver && leans {
             return None;
         }
+        Some(angles)
+    }
+
+    /// The tests of [`Self::score`] that read the edges and boundary edges at the corners,
+    /// for a triangle of the given `angles` that passed [`Self::shape`]: its score if it
+    /// passes them.
+    fn fits(&self, a: u32, b: u32, x: u32, angles: [f64; 3], min_floor: f64) -> Option<f64> {
+        // Each edge at most twice, once each way.
+        if self.edges.contains(a, x) || self.edges.contains(x, b) {
+            return None;
+        }
+        let min_angle = angles[0].min(angles[1]).min(angles[2]);
         // Corners where both of the triangle's edges are boundary edges now: there it fills
         // the whole open wedge, so a sharp angle there is the boundary's, not the triangle's.
         let fills = |v: u32, before: u32, after: u32| {
