@@ -593,8 +593,9 @@ struct Stitcher<'a, 'f, T, F> {
     /// What [`Self::refresh`] keeps of each edge it looked at.
     memos: EdgeMap<EdgeMemo>,
     heap: BinaryHeap<Candidate>,
-    /// Whether [`Self::in_open_wedge`] remembers its angles in `wedge_angles` (only during a
-    /// [`Self::refresh`], when no vertex moves or comes and goes).
+    /// Whether [`Self::in_open_wedge`] remembers its angles in `wedge_angles` (only while no
+    /// vertex is on trial: during a [`Self::refresh`], and in [`Self::acceptable`] for an
+    /// existing vertex).
     wedge_memo: std::cell::Cell<bool>,
     /// The angle of vertex `w` about vertex `v` in `v`'s tangent frame, by `(v, w)`.
     wedge_angles: std::cell::RefCell<HashMap<(u32, u32), f64, FastHash>>,
@@ -1125,16 +1126,18 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
     /// boundary in-edge's source counter-clockwise to a boundary out-edge's target, with no
     /// other boundary edge of `v` between.
     ///
-    /// During [`Self::refresh`] the angles about `v` are remembered (its candidates share
-    /// their edge's ends and the ends' boundary neighbours, and edges near each other share
-    /// candidates): the same value as computed anew, since an angle reads only the positions
-    /// and normals of its two vertices, which do not change once a vertex is registered, and
-    /// no vertex is on trial during a refresh.
+    /// While no vertex is on trial the angles about `v` are remembered (a refresh's candidates
+    /// share their edge's ends and the ends' boundary neighbours, edges near each other share
+    /// candidates, and a queued candidate was scored by a refresh): the same value as computed
+    /// anew, since an angle reads only the positions and normals of its two vertices, which
+    /// do not change once a vertex is registered (and a vertex on trial, whose id may come
+    /// back with another position, is never remembered).
     fn in_open_wedge(&self, v: u32, from: u32, to: u32) -> bool {
         let (outs, ins) = (self.boundary.outs(v), self.boundary.ins(v));
         let p = self.pos[v as usize];
         let n = self.nrm[v as usize];
-        let (e1, e2) = tangent_frame(n);
+        // (Only needed for angles not remembered.)
+        let frame = std::cell::OnceCell::new();
         let memo = self.wedge_memo.get();
         let angle = |w: u32| {
             if memo {
@@ -1142,6 +1145,7 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
                     return t;
                 }
             }
+            let (e1, e2) = *frame.get_or_init(|| tangent_frame(n));
             let d = sub(self.pos[w as usize], p);
             let t = dot(d, e2).atan2(dot(d, e1));
             if memo {
@@ -1149,7 +1153,21 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
             }
             t
         };
-        let ccw = |from: f64, to: f64| (to - from).rem_euclid(std::f64::consts::TAU);
+        let ccw = |from: f64, to: f64| {
+            use std::f64::consts::TAU;
+            let d = to - from;
+            // `d.rem_euclid(TAU)` without its `fmod` call for differences within a turn, as
+            // of two angles from atan2 (there `d % TAU` is `d`, exactly).
+            if d.abs() < TAU {
+                if d < 0.0 {
+                    d + TAU
+                } else {
+                    d
+                }
+            } else {
+                d.rem_euclid(TAU)
+            }
+        };
         let (af, at) = (angle(from), angle(to));
         let span = ccw(af, at);
         for &z in ins {
@@ -1184,13 +1202,12 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
             return false;
         }
         let reach = REACH * self.edge_scale(a, b);
-        if self
+        self.wedge_memo.set(!on_trial);
+        let scored = self
             .score(a, b, x, reach, MIN_ANGLE_DEG.to_radians())
-            .is_none()
-        {
-            return false;
-        }
-        self.clear(a, b, x) && self.meets_nothing(a, b, x)
+            .is_some();
+        self.wedge_memo.set(false);
+        scored && self.clear(a, b, x) && self.meets_nothing(a, b, x)
     }
 
     /// Whether triangle `(b, a, x)` meets no triangle near it other than along the edges and
