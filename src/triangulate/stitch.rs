@@ -2123,6 +2123,13 @@ fn cell_of(inv: f64, p: [f64; 3]) -> Cell {
     (k(p[0]), k(p[1]), k(p[2]))
 }
 
+/// How many cells the box of cells from `lo` to `hi` holds.
+fn cell_count(lo: Cell, hi: Cell) -> i64 {
+    (i64::from(hi.0) - i64::from(lo.0) + 1)
+        * (i64::from(hi.1) - i64::from(lo.1) + 1)
+        * (i64::from(hi.2) - i64::from(lo.2) + 1)
+}
+
 impl PointGrid {
     fn new(cell: f64) -> Self {
         PointGrid {
@@ -2156,10 +2163,7 @@ impl PointGrid {
     fn near(&self, p: [f64; 3], r: f64, mut f: impl FnMut(u32)) {
         let lo = cell_of(self.inv, p.map(|x| x - r));
         let hi = cell_of(self.inv, p.map(|x| x + r));
-        let count = (i64::from(hi.0) - i64::from(lo.0) + 1)
-            * (i64::from(hi.1) - i64::from(lo.1) + 1)
-            * (i64::from(hi.2) - i64::from(lo.2) + 1);
-        if count > self.cells.len() as i64 {
+        if cell_count(lo, hi) > self.cells.len() as i64 {
             // Fewer cells hold points than the box covers: those cells are scanned instead.
             // A cell two or more beyond the box on some axis is a whole cell farther than `r`
             // from `p`, far beyond any rounding, so none of its points is within `r`.
@@ -2211,10 +2215,36 @@ impl FaceGrid {
             later: Vec::new(),
             large: Vec::new(),
         };
+        // Each vertex's cell (`None` at a non-finite coordinate): the cells of a triangle's
+        // box run from its corners' lowest cells to their highest, since a coordinate's cell
+        // never decreases as it grows.
+        let vertex_cells: Vec<Option<Cell>> = pos
+            .iter()
+            .map(|p| {
+                p.iter()
+                    .all(|x| x.is_finite())
+                    .then(|| cell_of(grid.inv, *p))
+            })
+            .collect();
         // (row, triangle) for each cell a triangle's box meets, then grouped by row.
         let mut entries: Vec<(u32, u32)> = Vec::with_capacity(3 * tris.len());
         for (f, t) in tris.iter().enumerate() {
-            let (lo, hi, count) = grid.range(&corners(pos, *t));
+            let (lo, hi, count) = match t.map(|v| vertex_cells[v as usize]) {
+                [Some(a), Some(b), Some(c)] => {
+                    let lo = (
+                        a.0.min(b.0).min(c.0),
+                        a.1.min(b.1).min(c.1),
+                        a.2.min(b.2).min(c.2),
+                    );
+                    let hi = (
+                        a.0.max(b.0).max(c.0),
+                        a.1.max(b.1).max(c.1),
+                        a.2.max(b.2).max(c.2),
+                    );
+                    (lo, hi, cell_count(lo, hi))
+                }
+                _ => grid.range(&corners(pos, *t)),
+            };
             if count > 64 {
                 grid.large.push(f as u32);
                 continue;
@@ -2252,10 +2282,7 @@ impl FaceGrid {
         let lo = [0, 1, 2].map(|k| c[0][k].min(c[1][k]).min(c[2][k]));
         let hi = [0, 1, 2].map(|k| c[0][k].max(c[1][k]).max(c[2][k]));
         let (lo, hi) = (cell_of(self.inv, lo), cell_of(self.inv, hi));
-        let count = (i64::from(hi.0) - i64::from(lo.0) + 1)
-            * (i64::from(hi.1) - i64::from(lo.1) + 1)
-            * (i64::from(hi.2) - i64::from(lo.2) + 1);
-        (lo, hi, count)
+        (lo, hi, cell_count(lo, hi))
     }
     fn insert(&mut self, f: u32, c: [[f64; 3]; 3]) {
         let (lo, hi, count) = self.range(&c);
