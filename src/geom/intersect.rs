@@ -84,22 +84,48 @@ pub(crate) fn faces_intersect(p: &[P3], f: [u32; 3], g: [u32; 3]) -> bool {
 /// predicates `o` (which must be exact on `p`).
 #[cfg_attr(not(test), allow(dead_code))] // for the mesher's checks; tested here
 pub(crate) fn proper_faces_intersect<O: Orient>(o: O, p: &[P3], f: [u32; 3], g: [u32; 3]) -> bool {
-    let at = |t: [u32; 3]| [p[t[0] as usize], p[t[1] as usize], p[t[2] as usize]];
-    proper_corners_intersect(o, f, &at(f), g, &at(g))
+    let at =
+        |t: [u32; 3]| PlanarFace::new(o, t, [p[t[0] as usize], p[t[1] as usize], p[t[2] as usize]]);
+    planar_faces_intersect(o, &at(f), &at(g))
 }
 
-/// [`proper_faces_intersect`] with the corners `tf`, `tg` of faces `f`, `g` at hand.
+/// A proper face (three distinct indices, finite non-degenerate corners) with its plane,
+/// made once for the many tests of a face against its neighbours.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct PlanarFace<P> {
+    /// Vertex indices.
+    pub ids: [u32; 3],
+    /// The plane through its corners, in the order of `ids` (so it holds the corners).
+    pub plane: P,
+}
+
+impl<P> PlanarFace<P> {
+    /// Face `ids` with corners `corners`.
+    #[inline]
+    pub fn new<O: Orient<Plane = P>>(o: O, ids: [u32; 3], corners: Tri) -> Self {
+        PlanarFace {
+            ids,
+            plane: o.plane(corners[0], corners[1], corners[2]),
+        }
+    }
+}
+
+/// [`proper_faces_intersect`] for faces with their planes at hand (made with `o`).
+///
+/// A cyclic rotation of a plane's corners leaves every orientation against it unchanged, so
+/// the tests of faces sharing corners read the face's own plane whichever corner they put
+/// first.
 #[inline]
-pub(crate) fn proper_corners_intersect<O: Orient>(
+pub(crate) fn planar_faces_intersect<O: Orient>(
     o: O,
-    f: [u32; 3],
-    tf: &Tri,
-    g: [u32; 3],
-    tg: &Tri,
+    pf: &PlanarFace<O::Plane>,
+    pg: &PlanarFace<O::Plane>,
 ) -> bool {
-    let in_g = [g.contains(&f[0]), g.contains(&f[1]), g.contains(&f[2])];
+    let (f, g) = (pf.ids, pg.ids);
+    let (tf, tg) = (o.plane_corners(&pf.plane), o.plane_corners(&pg.plane));
+    let in_g = f.map(|x| (x == g[0]) | (x == g[1]) | (x == g[2]));
     match in_g[0] as u8 + in_g[1] as u8 + in_g[2] as u8 {
-        0 => tri_tri(o, tf, tg),
+        0 => tri_tri(o, tf, &pf.plane, tg, &pg.plane),
         1 => {
             // Rotate both so that the shared vertex comes first.
             let i = if in_g[0] {
@@ -117,7 +143,11 @@ pub(crate) fn proper_corners_intersect<O: Orient>(
                 2
             };
             let (v, b, c) = (tf[i], tf[(i + 1) % 3], tf[(i + 2) % 3]);
-            wedges_meet(o, v, b, c, tg[(j + 1) % 3], tg[(j + 2) % 3])
+            let sides = [o.side(&pg.plane, b), o.side(&pg.plane, c)];
+            if sides[0] * sides[1] > 0 {
+                return false;
+            }
+            wedges_meet(o, sides, v, b, c, tg[(j + 1) % 3], tg[(j + 2) % 3])
         }
         2 => {
             let i = if !in_g[0] {
@@ -134,7 +164,8 @@ pub(crate) fn proper_corners_intersect<O: Orient>(
             } else {
                 2
             };
-            folded_onto(o, tf[(i + 1) % 3], tf[(i + 2) % 3], tf[i], tg[j])
+            let (a, b, c) = (tf[(i + 1) % 3], tf[(i + 2) % 3], tf[i]);
+            folded_onto(o, &pf.plane, a, b, c, tg[j])
         }
         _ => true,
     }
@@ -237,7 +268,10 @@ fn shapes_intersect<O: Orient>(o: O, s: &Shape, t: &Shape) -> bool {
             let sq = o.orient3d(t[0], t[1], t[2], q);
             segment_meets_triangle(o, p, q, sp, sq, &t, k)
         }
-        (Triangle(a, _), Triangle(b, _)) => tri_tri(o, &a, &b),
+        (Triangle(a, _), Triangle(b, _)) => {
+            let plane = |t: Tri| o.plane(t[0], t[1], t[2]);
+            tri_tri(o, &a, &plane(a), &b, &plane(b))
+        }
     }
 }
 
@@ -332,15 +366,13 @@ fn segment_meets_triangle<O: Orient>(
     !mixed(s)
 }
 
-/// Two non-degenerate closed triangles.
-fn tri_tri<O: Orient>(o: O, a: &Tri, b: &Tri) -> bool {
-    let pb = o.plane(b[0], b[1], b[2]);
-    let sa = [o.side(&pb, a[0]), o.side(&pb, a[1]), o.side(&pb, a[2])];
+/// Two non-degenerate closed triangles `a` and `b`, with their planes `pa` and `pb`.
+fn tri_tri<O: Orient>(o: O, a: &Tri, pa: &O::Plane, b: &Tri, pb: &O::Plane) -> bool {
+    let sa = [o.side(pb, a[0]), o.side(pb, a[1]), o.side(pb, a[2])];
     if one_side(sa) {
         return false;
     }
-    let pa = o.plane(a[0], a[1], a[2]);
-    let sb = [o.side(&pa, b[0]), o.side(&pa, b[1]), o.side(&pa, b[2])];
+    let sb = [o.side(pa, b[0]), o.side(pa, b[1]), o.side(pa, b[2])];
     if one_side(sb) {
         return false;
     }
@@ -384,13 +416,11 @@ fn tri_tri<O: Orient>(o: O, a: &Tri, b: &Tri) -> bool {
 /// `u = sign[d,e,p] ([d,e,p] (q − v) − [d,e,q] (p − v))`, which lies in `W_g` iff
 /// `[d,e,p]·[d,q,p] ≥ 0` and `[d,e,p]·[q,e,p] ≥ 0`: two more orientations, no constructed
 /// point. Coplanar, two wedges of angle < π share a direction iff one holds a boundary ray
-/// of the other.
-fn wedges_meet<O: Orient>(o: O, v: P3, b: P3, c: P3, d: P3, e: P3) -> bool {
-    let g = o.plane(v, d, e);
-    let (sb, sc) = (o.side(&g, b), o.side(&g, c));
-    if sb * sc > 0 {
-        return false;
-    }
+/// of the other. `sides` are those of `b` and `c` against the plane of `(v, d, e)`; the
+/// caller has already answered `false` when they are strictly on one side (the usual case,
+/// and all it needs is the two signs).
+fn wedges_meet<O: Orient>(o: O, sides: [i8; 2], v: P3, b: P3, c: P3, d: P3, e: P3) -> bool {
+    let [sb, sc] = sides;
     if sb == 0 && sc == 0 {
         let k = drop_axis(o, v, d, e).unwrap_or(2);
         let [v, b, c, d, e] = [v, b, c, d, e].map(|p| proj(p, k));
@@ -414,9 +444,9 @@ fn wedges_meet<O: Orient>(o: O, v: P3, b: P3, c: P3, d: P3, e: P3) -> bool {
 /// Non-degenerate faces `(a, b, c)` and one with corners `a, b, d` (sharing the edge `ab`):
 /// a common point off the edge exists iff they are coplanar with `c` and `d` on the same
 /// side of `ab` (otherwise the planes meet only in the line `ab`, which each face meets in
-/// the edge alone).
-fn folded_onto<O: Orient>(o: O, a: P3, b: P3, c: P3, d: P3) -> bool {
-    if o.orient3d(a, b, c, d) != 0 {
+/// the edge alone). `f` is the plane of `(a, b, c)` (or of a cyclic rotation of it).
+fn folded_onto<O: Orient>(o: O, f: &O::Plane, a: P3, b: P3, c: P3, d: P3) -> bool {
+    if o.side(f, d) != 0 {
         return false;
     }
     let k = drop_axis(o, a, b, c).unwrap_or(2);
@@ -852,7 +882,9 @@ mod tests {
             assert_eq!(triangles_intersect(a, b), expected, "{a:?} {b:?}");
             // Validation's path: robust directly, with the filtered plane sides.
             if !triangle_is_degenerate(a) && !triangle_is_degenerate(b) {
-                assert_eq!(tri_tri(InRange, &a, &b), expected, "{a:?} {b:?}");
+                let plane = |t: Tri| InRange.plane(t[0], t[1], t[2]);
+                let got = tri_tri(InRange, &a, &plane(a), &b, &plane(b));
+                assert_eq!(got, expected, "{a:?} {b:?}");
             }
             hits += expected as usize;
             total += 1;

@@ -21,7 +21,7 @@ const FAST_LOW: i32 = -300;
 /// Orientation predicates, exact on the inputs the implementation accepts.
 pub(crate) trait Orient: Copy {
     /// What [`Orient::side`] needs of a plane, computed once for several points.
-    type Plane: Copy;
+    type Plane: Copy + Send + Sync;
     /// Sign of `det[b − a, c − a, d − a]`: positive when `d` lies on the side of the plane
     /// `abc` that `(b − a) × (c − a)` points to.
     fn orient3d(self, a: P3, b: P3, c: P3, d: P3) -> i8;
@@ -29,6 +29,8 @@ pub(crate) trait Orient: Copy {
     fn plane(self, a: P3, b: P3, c: P3) -> Self::Plane;
     /// `orient3d(a, b, c, d)` for the plane of [`Orient::plane`]`(a, b, c)`.
     fn side(self, plane: &Self::Plane, d: P3) -> i8;
+    /// The points `a, b, c` the plane was made from.
+    fn plane_corners(self, plane: &Self::Plane) -> &[P3; 3];
     /// Sign of `(b − a) × (c − a)`: positive when `a, b, c` turn counter-clockwise.
     fn orient2d(self, a: [f64; 2], b: [f64; 2], c: [f64; 2]) -> i8;
 }
@@ -126,6 +128,10 @@ impl Orient for InRange {
         }
     }
     #[inline]
+    fn plane_corners(self, pl: &FilteredPlane) -> &[P3; 3] {
+        &pl.corners
+    }
+    #[inline]
     fn orient2d(self, a: [f64; 2], b: [f64; 2], c: [f64; 2]) -> i8 {
         sign(robust::orient2d(c2(a), c2(b), c2(c)))
     }
@@ -138,6 +144,9 @@ impl Orient for Checked {
     }
     fn side(self, pl: &[P3; 3], d: P3) -> i8 {
         self.orient3d(pl[0], pl[1], pl[2], d)
+    }
+    fn plane_corners(self, pl: &[P3; 3]) -> &[P3; 3] {
+        pl
     }
     fn orient3d(self, a: P3, b: P3, c: P3, d: P3) -> i8 {
         if a.iter()

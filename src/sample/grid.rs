@@ -20,7 +20,15 @@ const TARGET_REACH: f64 = 0.35;
 /// [`TARGET_REACH`] cells.
 const RETUNE_FACTOR: f64 = 1.6;
 
-/// Point indices bucketed by cubic cells of side `1 / inv`.
+/// A filed point: its index, and a copy of its position, so that a query reads the
+/// candidates' positions from the bucket it scans rather than from all over the point list.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Filed {
+    pub index: u32,
+    pub at: [f64; 3],
+}
+
+/// Points bucketed by cubic cells of side `1 / inv`.
 ///
 /// The cell size starts at a guess and follows the query radii: every time the number of
 /// points doubles, the mean radius asked for since the last review is compared with the cell
@@ -28,7 +36,7 @@ const RETUNE_FACTOR: f64 = 1.6;
 /// return the same answers whatever the cell size; only their cost depends on it.
 pub(crate) struct Grid {
     inv: f64,
-    buckets: HashMap<Cell, Vec<u32>, FastHash>,
+    buckets: HashMap<Cell, Vec<Filed>, FastHash>,
     /// Points filed.
     len: usize,
     /// The number of points at which the cell size is next reviewed.
@@ -95,11 +103,15 @@ impl Grid {
 
     fn file(&mut self, p: [f64; 3], index: u32) {
         let key = self.key(p);
-        self.buckets.entry(key).or_default().push(index);
+        self.buckets
+            .entry(key)
+            .or_default()
+            .push(Filed { index, at: p });
     }
 
-    /// Whether `f` holds for some stored index whose cell meets the ball of `radius` around
-    /// `p` (a superset of the points within `radius`); stops at the first that does.
+    /// Whether `f(index, position)` holds for some stored point whose cell meets the ball of
+    /// `radius` around `p` (a superset of the points within `radius`); stops at the first
+    /// that does.
     ///
     /// When the ball's bounding box meets more cells than the grid has buckets (a radius of
     /// many cells: an initial Δt far below the step lengths), every bucket is visited
@@ -108,7 +120,7 @@ impl Grid {
         &self,
         p: [f64; 3],
         radius: f64,
-        mut f: impl FnMut(u32) -> bool,
+        mut f: impl FnMut(u32, [f64; 3]) -> bool,
     ) -> bool {
         // Only the cells the ball's bounding box meets: about (1 + 2ρ)³ for a radius of ρ
         // cells.
@@ -123,13 +135,13 @@ impl Grid {
             * (hi.1 as f64 - lo.1 as f64 + 1.0)
             * (hi.2 as f64 - lo.2 as f64 + 1.0);
         if radius.is_nan() || cells > self.buckets.len() as f64 {
-            return self.buckets.values().flatten().any(|&i| f(i));
+            return self.buckets.values().flatten().any(|e| f(e.index, e.at));
         }
         for x in lo.0..=hi.0 {
             for y in lo.1..=hi.1 {
                 for z in lo.2..=hi.2 {
                     if let Some(bucket) = self.buckets.get(&(x, y, z)) {
-                        if bucket.iter().any(|&i| f(i)) {
+                        if bucket.iter().any(|e| f(e.index, e.at)) {
                             return true;
                         }
                     }
@@ -158,7 +170,7 @@ mod tests {
     fn filled(cell: f64, points: &[[f64; 3]], radius: f64) -> Grid {
         let mut grid = Grid::new(cell);
         for (i, &p) in points.iter().enumerate() {
-            grid.any_near(p, radius, |_| false);
+            grid.any_near(p, radius, |_, _| false);
             grid.push(&points[..=i]);
         }
         grid
@@ -173,7 +185,8 @@ mod tests {
             for (k, &q) in queries[3000..].iter().enumerate() {
                 let radius = [0.0, 0.01, 0.05, 0.2][k % 4];
                 let mut seen = vec![false; points.len()];
-                grid.any_near(q, radius, |j| {
+                grid.any_near(q, radius, |j, at| {
+                    assert_eq!(at, points[j as usize]);
                     seen[j as usize] = true;
                     false
                 });
@@ -183,7 +196,7 @@ mod tests {
                         "cell {cell}: point {j} missed"
                     );
                 }
-                let hit = grid.any_near(q, radius, |j| dist(points[j as usize], q) <= radius);
+                let hit = grid.any_near(q, radius, |_, at| dist(at, q) <= radius);
                 let want = points.iter().any(|&p| dist(p, q) <= radius);
                 assert_eq!(hit, want, "cell {cell}, radius {radius}");
             }

@@ -151,6 +151,23 @@ const FENCE_RADIUS: f64 = 1.0;
 /// …and this many in half-thickness.
 const FENCE_THICKNESS: f64 = 0.35;
 
+/// A bound on squared distances beyond which the distance (`d².sqrt()`, as `dist` computes
+/// it) certainly exceeds `limit`, so that most candidates of a query are rejected without a
+/// square root and with the same answer.
+///
+/// `sqrt` is correctly rounded and monotone: if `d² > limit²·(1 + 2⁻⁵⁰)` then
+/// `√d² > limit·(1 + 2⁻⁵²) ≥ nextup(limit)`, which the rounding keeps. The bound computed here,
+/// `limit·limit·(1 + 2⁻⁴⁹)` with two roundings, is at least that while `limit²` is a normal
+/// number; otherwise (underflow, zero, NaN) it is infinite and rejects nothing.
+fn squared_bound_beyond(limit: f64) -> f64 {
+    let square = limit * limit;
+    if square >= f64::MIN_POSITIVE {
+        square * (1.0 + 8.0 * f64::EPSILON)
+    } else {
+        f64::INFINITY
+    }
+}
+
 /// Steps a curve waits before inserting on a side again after a curve it inserted there
 /// merged at once.
 const COOLDOWN_STEPS: f64 = 4.0;
@@ -550,13 +567,18 @@ impl<T: Scalar, F: NormalField<T>> Sampler<'_, T, F> {
             Some(_) => radius + (2.0 * drift_q).min(4.0 * len),
             None => radius,
         };
-        self.grid.any_near(q, reach, |j| {
-            let pj = self.pos[j as usize];
-            let d = dist(q, pj);
+        let beyond_reach = squared_bound_beyond(reach);
+        self.grid.any_near(q, reach, |j, pj| {
+            let e = sub(q, pj);
+            let d2 = dot(e, e);
+            // Farther than `reach` (≥ `radius`): not near in either mode.
+            if d2 > beyond_reach {
+                return false;
+            }
+            let d = d2.sqrt();
             let near = match normal {
                 None => d < radius,
                 Some(n) => {
-                    let e = sub(q, pj);
                     let along = dot(e, n);
                     let across = (d * d - along * along).max(0.0).sqrt();
                     // Only points within `reach`, so that the answer does not depend on
@@ -588,11 +610,18 @@ impl<T: Scalar, F: NormalField<T>> Sampler<'_, T, F> {
         let radius = FENCE_RADIUS * len;
         let thickness = FENCE_THICKNESS * len;
         let reach = half + radius;
-        self.grid.any_near(mid, reach, |j| {
+        let limit = half + reach;
+        let beyond_limit = squared_bound_beyond(limit);
+        self.grid.any_near(mid, reach, |j, xj| {
             let j = j as usize;
-            let xj = self.pos[j];
-            let dq = dist(q, xj);
-            if dq > half + reach {
+            let to_q = sub(q, xj);
+            let dq2 = dot(to_q, to_q);
+            // Most candidates lie beyond the limit: rejected without the square root.
+            if dq2 > beyond_limit {
+                return false;
+            }
+            let dq = dq2.sqrt();
+            if dq > limit {
                 return false;
             }
             let nj = self.nrm[j];
