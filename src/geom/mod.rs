@@ -6,6 +6,7 @@ pub(crate) mod grid;
 pub(crate) mod intersect;
 pub(crate) mod predicates;
 pub(crate) mod rng;
+pub(crate) mod rows;
 pub(crate) mod vec3;
 
 use crate::scalar::Vec3;

@@ -17,6 +17,7 @@ use super::Mesh;
 use crate::geom::grid::{cell_size, radix_sort, spatial_order, Aabb, PairGrid};
 use crate::geom::intersect::{is_collinear, planar_faces_intersect, PlanarFace};
 use crate::geom::predicates::{scale, Checked, Exponents, InRange, Orient, P3};
+use crate::geom::rows::rows_by_corner;
 use crate::par;
 use std::fmt;
 
@@ -429,24 +430,8 @@ pub(crate) fn validate_listing_crossings(
 /// vertices), offenders named by `old_vertex`.
 fn topology(faces: &[[u32; 3]], n: usize, old_vertex: &[u32], v: &mut Validation) {
     // Vertex → faces, by counting sort: faces ascending around each vertex.
-    let mut start = vec![0u32; n + 1];
-    for t in faces {
-        for &i in t {
-            start[i as usize + 1] += 1;
-        }
-    }
-    for i in 0..n {
-        start[i + 1] += start[i];
-    }
-    let mut fill = start.clone();
-    let mut slots = vec![0u32; start[n] as usize];
-    for (f, t) in faces.iter().enumerate() {
-        for &i in t {
-            slots[fill[i as usize] as usize] = f as u32;
-            fill[i as usize] += 1;
-        }
-    }
-    drop(fill);
+    let (start, slots) =
+        rows_by_corner(faces, n, |f, _| f as u32).expect("proper faces name vertices below n");
     let old = |i: u32| old_vertex[i as usize];
     let edge = |a: u32, b: u32| {
         let (a, b) = (old(a), old(b));

@@ -7,7 +7,7 @@
 //! when it keeps the mesh a consistently oriented 2-manifold whose faces agree with the field
 //! normal; flips that undo a fold (a face against the field normal) come first.
 
-use super::rows_by_corner;
+use crate::geom::rows::rows_by_corner;
 use crate::geom::vec3::{cross, dot, sub, FastHash};
 use crate::par;
 use std::collections::{HashMap, VecDeque};

@@ -577,35 +577,6 @@ fn inside_star(chart: &[[f64; 2]], front: &[u32], (a0, rel): (f64, &[f64]), c: [
     cross2(sub2(b, a), sub2(c, a)) >= 0.0
 }
 
-/// Rows by vertex, in triangle order: `value(t, k)` for every corner `k` of every triangle
-/// `t`, filed under the corner's vertex (compressed rows: vertex `v`'s values are
-/// `list[start[v]..start[v + 1]]`). Returns `(start, list)`, or `None` if a corner is not
-/// below `vertices`.
-fn rows_by_corner(
-    triangles: &[[u32; 3]],
-    vertices: usize,
-    value: impl Fn(usize, usize) -> u32,
-) -> Option<(Vec<u32>, Vec<u32>)> {
-    let mut start = vec![0u32; vertices + 1];
-    for t in triangles {
-        for &v in t {
-            *start.get_mut(v as usize + 1)? += 1;
-        }
-    }
-    for v in 0..vertices {
-        start[v + 1] += start[v];
-    }
-    let mut fill: Vec<u32> = start[..vertices].to_vec();
-    let mut list = vec![0u32; start[vertices] as usize];
-    for (t, tr) in triangles.iter().enumerate() {
-        for (k, &v) in tr.iter().enumerate() {
-            list[fill[v as usize] as usize] = value(t, k);
-            fill[v as usize] += 1;
-        }
-    }
-    Some((start, list))
-}
-
 /// A polygon for even-odd tests of many points: its edges filed by the rows of `y` they
 /// span, so that a point is tested against only the edges in its row instead of all of
 /// them. Only edges whose `y` range holds the point's `y` can change the answer, and each of

@@ -7,7 +7,8 @@
 //! where they are. Edge flips afterwards restore the surface Delaunay property.
 
 use super::flip::{agreement_at, flip_to_surface_delaunay};
-use super::{rows_by_corner, Mesh};
+use super::Mesh;
+use crate::geom::rows::rows_by_corner;
 use crate::par;
 use crate::params::Resolved;
 use crate::scalar::{Scalar, Vec3};

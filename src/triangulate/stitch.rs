@@ -37,6 +37,7 @@
 //! end are cut apart by removing the fewer triangles of the vertex.
 
 use crate::geom::intersect::faces_intersect;
+use crate::geom::rows::{compressed_rows, rows_by_corner};
 use crate::geom::vec3::{cross, dist, dot, sub, FastHash};
 use crate::mesh::{Mesh, Provenance};
 use crate::scalar::{Scalar, Vec3};
@@ -115,27 +116,8 @@ const GONE: u32 = u32::MAX;
 impl EdgeSet {
     /// The edges of `tris`, whose corners are below `vertices`.
     fn new(vertices: usize, tris: &[[u32; 3]]) -> Self {
-        // Counts, summed into the ends of the rows, then each row filled from its end.
-        let mut start = vec![0u32; vertices + 1];
-        for t in tris {
-            for &u in t {
-                start[u as usize + 1] += 1;
-            }
-        }
-        for v in 0..vertices {
-            start[v + 1] += start[v];
-        }
-        let mut targets = vec![0u32; 3 * tris.len()];
-        for t in tris {
-            for k in 0..3 {
-                let end = &mut start[t[k] as usize + 1];
-                *end -= 1;
-                targets[*end as usize] = t[(k + 1) % 3];
-            }
-        }
-        // Each row's end has come down to its start: row `u` begins at `start[u + 1]`.
-        start.copy_within(1.., 0);
-        start[vertices] = targets.len() as u32;
+        let (start, targets) = rows_by_corner(tris, vertices, |t, k| tris[t][(k + 1) % 3])
+            .expect("the triangles' corners are vertices of the mesh");
         EdgeSet {
             start,
             targets,
@@ -2013,27 +1995,17 @@ fn pinched_fans(triangles: &[[u32; 3]], candidate: impl Fn(u32) -> bool) -> (Vec
         .max()
         .map_or(0, |&m| m as usize + 1);
     // Vertex → triangles, in compressed rows, for the candidates.
-    let mut start = vec![0u32; n + 1];
-    for t in triangles.iter().filter(|t| **t != DEAD) {
-        for &v in t {
-            if candidate(v) {
-                start[v as usize + 1] += 1;
-            }
-        }
-    }
-    for v in 0..n {
-        start[v + 1] += start[v];
-    }
-    let mut fill = start.clone();
-    let mut star = vec![0u32; start[n] as usize];
-    for (f, t) in triangles.iter().enumerate().filter(|(_, t)| **t != DEAD) {
-        for &v in t {
-            if candidate(v) {
-                star[fill[v as usize] as usize] = f as u32;
-                fill[v as usize] += 1;
-            }
-        }
-    }
+    let candidate = &candidate;
+    let corners = triangles
+        .iter()
+        .enumerate()
+        .filter(|(_, t)| **t != DEAD)
+        .flat_map(|(f, t)| {
+            t.iter()
+                .filter(|&&v| candidate(v))
+                .map(move |&v| (v as usize, f as u32))
+        });
+    let (start, star) = compressed_rows(n, corners).expect("n is above every live corner");
     let (mut pinched, mut drop) = (Vec::new(), Vec::new());
     let mut group: Vec<usize> = Vec::new();
     let (mut roots, mut sizes): (Vec<usize>, Vec<(usize, usize)>) = (Vec::new(), Vec::new());
@@ -2260,19 +2232,8 @@ impl FaceGrid {
             }
         }
         let rows = grid.rows.len();
-        let mut start = vec![0u32; rows + 1];
-        for &(r, _) in &entries {
-            start[r as usize + 1] += 1;
-        }
-        for r in 0..rows {
-            start[r + 1] += start[r];
-        }
-        let mut fill = start.clone();
-        let mut filed = vec![0u32; entries.len()];
-        for &(r, f) in &entries {
-            filed[fill[r as usize] as usize] = f;
-            fill[r as usize] += 1;
-        }
+        let (start, filed) = compressed_rows(rows, entries.iter().map(|&(r, f)| (r as usize, f)))
+            .expect("every entry's row is one of the grid's");
         grid.start = start;
         grid.filed = filed;
         grid.later = vec![Vec::new(); rows];
