@@ -44,10 +44,12 @@ const HAMILTONIAN_POINTS: usize = 40_000;
 /// and 0 of 256 cases with these seeds, see docs/status.md. Every mesh must still be valid.
 const BAND_MISSES: u32 = 5;
 
-/// The share of round tori (in percent) allowed to come out valid but not closed (most often
-/// an open tube: the ring was not sampled all the way round): measured at 45 of 256 cases, see
-/// docs/status.md.
-const TORUS_MISSES: u32 = 25;
+/// The share of round tori (in percent) allowed to come out valid but not closed (an open tube,
+/// or one hole left where fronts met): measured at 10 of 256 cases, see docs/status.md.
+const TORUS_MISSES: u32 = 10;
+
+/// The same for tilted tori with an elliptic tube: measured at 12 of 64 cases.
+const TILTED_TORUS_MISSES: u32 = 25;
 
 fn runner(seed: u64) -> TestRunner {
     let mut config = Config {
@@ -547,9 +549,9 @@ fn tori_close_with_euler_characteristic_zero() {
 }
 
 #[test]
-#[ignore = "open: 10 of 24 tilted elliptic tori stay open (most as a tube); see docs/status.md"]
+#[ignore = "open: 12 of 64 tilted elliptic tori stay open; see docs/status.md"]
 fn tilted_elliptic_tori_close_with_euler_characteristic_zero() {
-    tolerating(TORUS_MISSES, || torus_class(0x7052, true));
+    tolerating(TILTED_TORUS_MISSES, || torus_class(0x7052, true));
 }
 
 #[test]

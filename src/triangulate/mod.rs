@@ -35,7 +35,7 @@ pub(crate) use crate::mesh::octahedron;
 pub use crate::mesh::{Mesh, Provenance};
 
 use crate::error::MeshError;
-use crate::geom::vec3::{cross as cross3, dist as dist3, sub as sub3};
+use crate::geom::vec3::{cross as cross3, dist as dist3, sub as sub3, FastHash};
 use crate::model::LocalShape;
 use crate::params::Resolved;
 use crate::sample::{CurveEnd, Samples};
@@ -43,6 +43,7 @@ use crate::scalar::{Scalar, Vec3};
 use crate::trace::StepConfig;
 use crate::NormalField;
 use spade::{ConstrainedDelaunayTriangulation, HasPosition, Point2, Triangulation as _};
+use std::collections::HashSet;
 
 /// The chart-1 triangulation, kept for audits (empty-circumcircle checks, snapshots).
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -144,24 +145,6 @@ pub(crate) fn stitch<T: Scalar, F: NormalField<T>>(
     mesh: &mut Mesh,
     vertices: &mut Vec<Vec3<T>>,
 ) -> Stitched {
-    // Ends of curves that ended on a terminal condition, a singular point or a budget.
-    let rim: Vec<stitch::Rim> = mesh
-        .provenance
-        .iter()
-        .map(|pr| {
-            let Some(curve) = samples.curves.get(pr.curve as usize) else {
-                return stitch::Rim::Open;
-            };
-            if pr.step as usize + 1 != curve.points.len() {
-                return stitch::Rim::Open;
-            }
-            match curve.end {
-                CurveEnd::Radius | CurveEnd::BoundingBox => stitch::Rim::Terminal,
-                CurveEnd::Singular | CurveEnd::Budget => stitch::Rim::Barren,
-                CurveEnd::Collision | CurveEnd::Merge => stitch::Rim::Open,
-            }
-        })
-        .collect();
     // New points only on an integrable field: checked at p0 and at samples spread over the
     // run (a field may be integrable near p0 and not farther out).
     let probes = 16.min(samples.points.len()).max(1);
@@ -170,6 +153,21 @@ pub(crate) fn stitch<T: Scalar, F: NormalField<T>>(
         LocalShape::at::<T, F>(field, samples.points[i].to_f64())
             .is_none_or(|s| s.integrability_defect < INTEGRABLE_DEFECT)
     });
+    // Ends of curves that ended on a terminal condition, a singular point or a budget.
+    let rim_of = |pr: &Provenance| {
+        let Some(curve) = samples.curves.get(pr.curve as usize) else {
+            return stitch::Rim::Open;
+        };
+        if pr.step as usize + 1 != curve.points.len() {
+            return stitch::Rim::Open;
+        }
+        match curve.end {
+            CurveEnd::Radius | CurveEnd::BoundingBox => stitch::Rim::Terminal,
+            CurveEnd::Singular | CurveEnd::Budget => stitch::Rim::Barren,
+            CurveEnd::Collision | CurveEnd::Merge => stitch::Rim::Open,
+        }
+    };
+    let rim: Vec<stitch::Rim> = mesh.provenance.iter().map(rim_of).collect();
     let growth = stitch::Growth {
         field,
         cfg: StepConfig::new(params),
@@ -178,7 +176,118 @@ pub(crate) fn stitch<T: Scalar, F: NormalField<T>>(
         max_vertices: params.max_points,
         new_points: integrable,
     };
-    stitch::stitch(mesh, vertices, &rim, &growth)
+    let stitched = stitch::stitch(mesh, vertices, &rim, &[], &growth);
+    let open = open_boundary_edges(mesh, &rim);
+    if open == 0 || !integrable {
+        return stitched;
+    }
+    // Boundary left open between fronts that met: most often where the chart's triangles were
+    // dropped over a long stretch (the far side of a torus's ring), and the front, placing
+    // points of its own, could not grow across it. The stitching is tried again from the
+    // chart's mesh with the samples the chart left without triangles offered as free
+    // vertices, at their own spacing (see the `stitch` module); the result with less open
+    // boundary is kept. (Offering them always costs the sphere's far cap, where curves crowd,
+    // as much time as the rest of the stitching, and changes nothing there.)
+    let improve = params.mode == crate::params::Mode::Default;
+    let Ok((mut retry, _)) = triangulate(samples, params.close, improve) else {
+        return stitched;
+    };
+    let mut retry_vertices: Vec<Vec3<T>> = retry
+        .provenance
+        .iter()
+        .map(|pr| {
+            samples.points[samples.curves[pr.curve as usize].points[pr.step as usize] as usize]
+                .clone()
+        })
+        .collect();
+    let first_free = retry.vertices.len();
+    let mut used = vec![false; samples.points.len()];
+    for pr in &retry.provenance {
+        if let Some(&i) = samples
+            .curves
+            .get(pr.curve as usize)
+            .and_then(|c| c.points.get(pr.step as usize))
+        {
+            used[i as usize] = true;
+        }
+    }
+    let spacing = local_spacing(samples);
+    let mut free = Vec::new();
+    for (i, _) in used.iter().enumerate().filter(|(_, &u)| !u) {
+        free.push((retry.vertices.len() as u32, spacing[i]));
+        retry.vertices.push(samples.points[i].to_f64());
+        retry.normals.push(samples.normals[i].to_f64());
+        retry.provenance.push(samples.provenance[i]);
+        retry_vertices.push(samples.points[i].clone());
+    }
+    if free.is_empty() {
+        return stitched;
+    }
+    let retry_rim: Vec<stitch::Rim> = retry.provenance.iter().map(rim_of).collect();
+    let again = stitch::stitch(&mut retry, &mut retry_vertices, &retry_rim, &free, &growth);
+    drop_free_left(
+        &mut retry,
+        &mut retry_vertices,
+        first_free..first_free + free.len(),
+    );
+    let retry_rim: Vec<stitch::Rim> = retry.provenance.iter().map(rim_of).collect();
+    if open_boundary_edges(&retry, &retry_rim) < open {
+        *mesh = retry;
+        *vertices = retry_vertices;
+        again
+    } else {
+        stitched
+    }
+}
+
+/// How many boundary edges of `mesh` have neither end on a curve that ended on a terminal
+/// condition, a singular point or a budget (`rim`; vertices beyond it were added by the
+/// stitching): boundary where fronts met and were not stitched.
+fn open_boundary_edges(mesh: &Mesh, rim: &[stitch::Rim]) -> usize {
+    let mut edges: HashSet<(u32, u32), FastHash> = HashSet::default();
+    for t in &mesh.triangles {
+        for k in 0..3 {
+            edges.insert((t[k], t[(k + 1) % 3]));
+        }
+    }
+    let open = |v: u32| rim.get(v as usize).is_none_or(|r| *r == stitch::Rim::Open);
+    edges
+        .iter()
+        .filter(|&&(a, b)| !edges.contains(&(b, a)) && open(a) && open(b))
+        .count()
+}
+
+/// Takes the vertices in `range` that are on no triangle out of `mesh` and `vertices`,
+/// renumbering the rest.
+fn drop_free_left<T>(mesh: &mut Mesh, vertices: &mut Vec<Vec3<T>>, range: std::ops::Range<usize>) {
+    if range.is_empty() {
+        return;
+    }
+    let mut used = vec![false; mesh.vertices.len()];
+    for t in &mesh.triangles {
+        for &v in t {
+            used[v as usize] = true;
+        }
+    }
+    let mut remap = vec![u32::MAX; mesh.vertices.len()];
+    let mut next = 0usize;
+    for i in 0..mesh.vertices.len() {
+        if used[i] || !range.contains(&i) {
+            remap[i] = next as u32;
+            mesh.vertices[next] = mesh.vertices[i];
+            mesh.normals[next] = mesh.normals[i];
+            mesh.provenance[next] = mesh.provenance[i];
+            vertices.swap(next, i);
+            next += 1;
+        }
+    }
+    mesh.vertices.truncate(next);
+    mesh.normals.truncate(next);
+    mesh.provenance.truncate(next);
+    vertices.truncate(next);
+    for t in &mut mesh.triangles {
+        *t = t.map(|v| remap[v as usize]);
+    }
 }
 
 /// Chart triangles whose normal is further than this from their corners' field normals are

@@ -24,6 +24,15 @@
 //! meets in two pairs of arcs becomes a torus; boundary that faces nothing (a geodesic radius,
 //! the bounding box) stays boundary.
 //!
+//! Where the front leaves boundary open between fronts that met, the stitching is tried once
+//! more from the chart's triangles with the samples the chart left without one offered as
+//! *free* vertices: candidates like boundary vertices (a triangle on one has the whole wedge
+//! there), obstacles to triangles that would pass over them, at their own sample spacing, with
+//! near-duplicates of the mesh or of each other left out. The front then advances through the
+//! samples where the chart's triangles were dropped over a long stretch (the far side of a
+//! thin torus's ring), instead of growing its own points across it; the try with less open
+//! boundary is kept (`triangulate::stitch`).
+//!
 //! Holes that the front leaves open between fronts that met (no vertex of theirs ended a curve
 //! on a terminal condition) are, on an integrable field, filled through a chart of their own at
 //! the end: the hole's loop is projected onto the plane across its mean field normal,
@@ -147,6 +156,12 @@ impl EdgeSet {
             self.added.resize(u + 1, Vec::new());
         }
         self.added[u].push(v);
+    }
+
+    /// Whether some edge leaves `u` (whether `u` is on a triangle).
+    fn any_from(&self, u: u32) -> bool {
+        self.chart_row(u).iter().any(|&t| t != GONE)
+            || self.added.get(u as usize).is_some_and(|l| !l.is_empty())
     }
 
     fn remove(&mut self, u: u32, v: u32) {
@@ -395,15 +410,17 @@ pub(crate) fn stitch<T: Scalar, F: NormalField<T>>(
     mesh: &mut Mesh,
     work: &mut Vec<Vec3<T>>,
     rim: &[Rim],
+    free: &[(u32, f64)],
     growth: &Growth<'_, T, F>,
 ) -> Stitched {
-    let mut s = Stitcher::new(mesh, work, rim, growth);
+    let mut s = Stitcher::new(mesh, work, rim, free, growth);
     let mut out = Stitched::default();
     // The vertices whose boundary edges the next round looks at (all, at first; around the
     // holes that were opened, later).
     let mut opened: Option<HashSet<u32, FastHash>> = None;
     for round in 0..=REDO_ROUNDS {
-        let budget = 8 * s.boundary_edges() + 64;
+        // (Each free vertex takes about two triangles to take in.)
+        let budget = 8 * (s.boundary_edges() + 2 * s.free_left()) + 64;
         let edges: Vec<(u32, u32)> = match &opened {
             None => s.boundary_edge_list(),
             Some(near) => {
@@ -584,6 +601,8 @@ struct Stitcher<'a, 'f, T, F> {
     /// A count per vertex of the changes to the edges and boundary edges at it (see
     /// [`Self::touch`]).
     epoch: Vec<u32>,
+    /// Which vertices are free samples (see [`Self::is_free`]).
+    free: Vec<bool>,
 }
 
 impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
@@ -591,6 +610,7 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
         mesh: &mut Mesh,
         work: &'a mut Vec<Vec3<T>>,
         rim: &[Rim],
+        free: &[(u32, f64)],
         growth: &'a Growth<'f, T, F>,
     ) -> Self {
         let tris = std::mem::take(&mut mesh.triangles);
@@ -628,6 +648,27 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
             points.insert(v, pos[v as usize]);
         }
         let faces = FaceGrid::new(cell, &pos, &tris);
+        // Samples on no triangle are candidates like boundary vertices, at their own spacing,
+        // unless one lies right next to the mesh or to another one kept (a near-duplicate
+        // would only make slivers): where fronts met and the chart's triangles were dropped,
+        // the front then advances through the samples instead of placing points of its own.
+        let mut kept = PointGrid::new(cell);
+        let mut is_free = vec![false; n];
+        for &(v, h) in free {
+            let p = pos[v as usize];
+            let r = HOVER * h;
+            let mut near = false;
+            faces.near(&[p.map(|x| x - r), p.map(|x| x + r), p], |f| {
+                near = near || point_triangle_distance(p, corners(&pos, tris[f as usize])) < r;
+            });
+            kept.near(p, r, |w| near = near || dist(pos[w as usize], p) < r);
+            if !near && h > 0.0 {
+                boundary.set_scale(v, h);
+                points.insert(v, p);
+                kept.insert(v, p);
+                is_free[v as usize] = true;
+            }
+        }
         let mut rim = rim.to_vec();
         rim.resize(pos.len(), Rim::Open);
         Stitcher {
@@ -649,6 +690,7 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
             wedge_memo: std::cell::Cell::new(false),
             wedge_angles: std::cell::RefCell::new(HashMap::default()),
             epoch: Vec::new(),
+            free: is_free,
         }
     }
 
@@ -669,6 +711,25 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
 
     fn on_boundary(&self, v: u32) -> bool {
         !self.boundary.outs(v).is_empty()
+    }
+
+    /// Whether `v` is a free sample (one the chart left without a triangle) still on none.
+    fn is_free(&self, v: u32) -> bool {
+        self.free.get(v as usize).copied().unwrap_or(false) && !self.edges.any_from(v)
+    }
+
+    /// How many free vertices there are.
+    fn free_left(&self) -> usize {
+        self.boundary
+            .records
+            .iter()
+            .filter(|r| self.is_free(r.vertex))
+            .count()
+    }
+
+    /// Whether a triangle may be made on `v`: a boundary vertex, or a free one.
+    fn is_candidate(&self, v: u32) -> bool {
+        self.on_boundary(v) || self.is_free(v)
     }
 
     fn local(&self, v: u32) -> f64 {
@@ -708,7 +769,7 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
         let mut best: Option<(f64, u32)> = None;
         self.wedge_memo.set(true);
         for &(_, x) in &memo.nearest {
-            if !self.on_boundary(x) || memo.rejected.contains(&x) {
+            if !self.is_candidate(x) || memo.rejected.contains(&x) {
                 continue;
             }
             // A score is 4 per glued edge plus the smallest angle (below 3.5): a candidate
@@ -937,14 +998,13 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
         // Nothing already there: no boundary vertex nearer than half the new edges.
         let mut crowded = false;
         self.points.near(q, 0.5 * h, |w| {
-            // Only boundary vertices: interior ones are guarded by the triangles' clearance
-            // below, and vertices an opened hole left without triangles are no longer part of
-            // the mesh (counting them kept new points out of every opened hole).
+            // Only candidates (boundary and free vertices): interior ones are guarded by the
+            // triangles' clearance below.
             crowded = crowded
                 || (w != a
                     && w != b
                     && dist(self.pos[w as usize], q) < 0.5 * h
-                    && self.on_boundary(w));
+                    && self.is_candidate(w));
         });
         if crowded {
             return None;
@@ -1090,6 +1150,7 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
                 && self.in_open_wedge(b, a, x)
                 && (self.prov[x as usize].curve == Provenance::CLOSING_CURVE
                     && !self.on_boundary(x)
+                    || self.is_free(x)
                     || self.in_open_wedge(x, b, a)))
         {
             return None;
@@ -1180,7 +1241,7 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
     /// the triangles near it; `x` may be the new point on trial.
     fn acceptable(&self, a: u32, b: u32, x: u32, on_trial: bool) -> bool {
         // (A vertex on trial is on no triangle yet.)
-        if !self.is_boundary_edge(a, b) || !(on_trial || self.on_boundary(x)) {
+        if !self.is_boundary_edge(a, b) || !(on_trial || self.is_candidate(x)) {
             return false;
         }
         let reach = REACH * self.edge_scale(a, b);
@@ -1236,10 +1297,15 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
             + clearance;
         let mut crowded = false;
         self.points.near(centre, radius, |w| {
+            let p = self.pos[w as usize];
             crowded = crowded
                 || (!t.contains(&w)
-                    && self.on_boundary(w)
-                    && point_triangle_distance(self.pos[w as usize], corners_t) < clearance);
+                    && (self.on_boundary(w)
+                        // A free vertex right next to a corner is a near-duplicate of it and
+                        // stays unused; one farther in would be left under the triangle.
+                        || self.is_free(w)
+                            && corners_t.iter().all(|&c| dist(c, p) > 2.0 * clearance))
+                    && point_triangle_distance(p, corners_t) < clearance);
         });
         !crowded
     }
