@@ -227,14 +227,7 @@ pub fn run_observed<T: Scalar, F: NormalField<T>>(
     let improve = params.mode == Mode::Default;
     let (mut mesh, chart) = triangulate::triangulate(&samples, params.close, improve)?;
     // The mesh's vertices in the working precision, found by provenance.
-    let mut vertices: Vec<scalar::Vec3<T>> = mesh
-        .provenance
-        .iter()
-        .map(|pr| {
-            samples.points[samples.curves[pr.curve as usize].points[pr.step as usize] as usize]
-                .clone()
-        })
-        .collect();
+    let mut vertices = triangulate::sample_vertices(&samples, &mesh);
     let stitched = if params.close {
         observe(Progress::at(
             Stage::Stitching,

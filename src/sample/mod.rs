@@ -107,6 +107,15 @@ pub struct Samples<T> {
 }
 
 impl<T> Samples<T> {
+    /// The sample point a vertex of provenance `pr` is, if it is one (not a point added to
+    /// close the surface or by refinement).
+    pub(crate) fn point_of(&self, pr: &Provenance) -> Option<u32> {
+        self.curves
+            .get(pr.curve as usize)
+            .and_then(|c| c.points.get(pr.step as usize))
+            .copied()
+    }
+
     /// How many curves ended for each reason.
     pub fn ends(&self) -> CurveEnds {
         let mut e = CurveEnds::default();

@@ -35,7 +35,7 @@ pub(crate) use crate::mesh::octahedron;
 pub use crate::mesh::{Mesh, Provenance};
 
 use crate::error::MeshError;
-use crate::geom::vec3::{cross as cross3, dist as dist3, sub as sub3, FastHash};
+use crate::geom::vec3::{cross as cross3, dist as dist3, sub as sub3};
 use crate::model::LocalShape;
 use crate::params::Resolved;
 use crate::sample::{CurveEnd, Samples};
@@ -43,7 +43,6 @@ use crate::scalar::{Scalar, Vec3};
 use crate::trace::StepConfig;
 use crate::NormalField;
 use spade::{ConstrainedDelaunayTriangulation, HasPosition, Point2, Triangulation as _};
-use std::collections::HashSet;
 
 /// The chart-1 triangulation, kept for audits (empty-circumcircle checks, snapshots).
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -134,6 +133,18 @@ pub fn triangulate<T: Scalar>(
 
 use crate::model::INTEGRABLE_DEFECT;
 
+/// The working-precision points of the vertices of `mesh`, every one a sample (a mesh as
+/// [`triangulate`] makes it).
+pub(crate) fn sample_vertices<T: Scalar>(samples: &Samples<T>, mesh: &Mesh) -> Vec<Vec3<T>> {
+    mesh.provenance
+        .iter()
+        .map(|pr| {
+            let i = samples.point_of(pr).expect("chart vertices are samples");
+            samples.points[i as usize].clone()
+        })
+        .collect()
+}
+
 /// Stitches the chart mesh where its fronts meet (see the `stitch` module): triangles
 /// between boundary parts that face each other and, on an integrable field, new vertices on
 /// the surface where a gap has none. `vertices` holds the mesh's vertices in the working
@@ -176,8 +187,7 @@ pub(crate) fn stitch<T: Scalar, F: NormalField<T>>(
         max_vertices: params.max_points,
         new_points: integrable,
     };
-    let stitched = stitch::stitch(mesh, vertices, &rim, &[], &growth);
-    let open = open_boundary_edges(mesh, &rim);
+    let (stitched, open) = stitch::stitch(mesh, vertices, &rim, &[], &growth);
     if open == 0 || !integrable {
         return stitched;
     }
@@ -186,30 +196,21 @@ pub(crate) fn stitch<T: Scalar, F: NormalField<T>>(
     // points of its own, could not grow across it. The stitching is tried again from the
     // chart's mesh with the samples the chart left without triangles offered as free
     // vertices, at their own spacing (see the `stitch` module); the result with less open
-    // boundary is kept. (Offering them always costs the sphere's far cap, where curves crowd,
-    // as much time as the rest of the stitching, and changes nothing there.)
+    // boundary is kept. (Offering them always would cost the sphere's far cap, where curves
+    // crowd, most of the stitching's time again, and change its mesh.)
     let improve = params.mode == crate::params::Mode::Default;
     let Ok((mut retry, _)) = triangulate(samples, params.close, improve) else {
         return stitched;
     };
-    let mut retry_vertices: Vec<Vec3<T>> = retry
-        .provenance
-        .iter()
-        .map(|pr| {
-            samples.points[samples.curves[pr.curve as usize].points[pr.step as usize] as usize]
-                .clone()
-        })
-        .collect();
+    let mut retry_vertices = sample_vertices(samples, &retry);
     let first_free = retry.vertices.len();
     let mut used = vec![false; samples.points.len()];
-    for pr in &retry.provenance {
-        if let Some(&i) = samples
-            .curves
-            .get(pr.curve as usize)
-            .and_then(|c| c.points.get(pr.step as usize))
-        {
-            used[i as usize] = true;
-        }
+    for i in retry
+        .provenance
+        .iter()
+        .filter_map(|pr| samples.point_of(pr))
+    {
+        used[i as usize] = true;
     }
     let spacing = local_spacing(samples);
     let mut free = Vec::new();
@@ -224,37 +225,20 @@ pub(crate) fn stitch<T: Scalar, F: NormalField<T>>(
         return stitched;
     }
     let retry_rim: Vec<stitch::Rim> = retry.provenance.iter().map(rim_of).collect();
-    let again = stitch::stitch(&mut retry, &mut retry_vertices, &retry_rim, &free, &growth);
-    drop_free_left(
-        &mut retry,
-        &mut retry_vertices,
-        first_free..first_free + free.len(),
-    );
-    let retry_rim: Vec<stitch::Rim> = retry.provenance.iter().map(rim_of).collect();
-    if open_boundary_edges(&retry, &retry_rim) < open {
+    let (again, open_again) =
+        stitch::stitch(&mut retry, &mut retry_vertices, &retry_rim, &free, &growth);
+    if open_again < open {
+        drop_free_left(
+            &mut retry,
+            &mut retry_vertices,
+            first_free..first_free + free.len(),
+        );
         *mesh = retry;
         *vertices = retry_vertices;
         again
     } else {
         stitched
     }
-}
-
-/// How many boundary edges of `mesh` have neither end on a curve that ended on a terminal
-/// condition, a singular point or a budget (`rim`; vertices beyond it were added by the
-/// stitching): boundary where fronts met and were not stitched.
-fn open_boundary_edges(mesh: &Mesh, rim: &[stitch::Rim]) -> usize {
-    let mut edges: HashSet<(u32, u32), FastHash> = HashSet::default();
-    for t in &mesh.triangles {
-        for k in 0..3 {
-            edges.insert((t[k], t[(k + 1) % 3]));
-        }
-    }
-    let open = |v: u32| rim.get(v as usize).is_none_or(|r| *r == stitch::Rim::Open);
-    edges
-        .iter()
-        .filter(|&&(a, b)| !edges.contains(&(b, a)) && open(a) && open(b))
-        .count()
 }
 
 /// Takes the vertices in `range` that are on no triangle out of `mesh` and `vertices`,

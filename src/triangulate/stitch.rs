@@ -405,14 +405,18 @@ pub(crate) struct Growth<'f, T, F> {
 /// grows with them; `rim[v]` says whether vertex `v` ended a curve on a terminal condition or
 /// where the surface cannot be continued
 /// (a geodesic radius, the bounding box, a singular point, a budget): no new point is placed
-/// beyond those.
+/// beyond those. `free` lists the vertices on no triangle offered as free vertices, with their
+/// sample spacing (see the module docs).
+///
+/// Returns what it did, and how many boundary edges are left with neither end on such a rim:
+/// boundary between fronts that met and were not stitched.
 pub(crate) fn stitch<T: Scalar, F: NormalField<T>>(
     mesh: &mut Mesh,
     work: &mut Vec<Vec3<T>>,
     rim: &[Rim],
     free: &[(u32, f64)],
     growth: &Growth<'_, T, F>,
-) -> Stitched {
+) -> (Stitched, usize) {
     let mut s = Stitcher::new(mesh, work, rim, free, growth);
     let mut out = Stitched::default();
     // The vertices whose boundary edges the next round looks at (all, at first; around the
@@ -515,6 +519,11 @@ pub(crate) fn stitch<T: Scalar, F: NormalField<T>>(
         s.remove_triangle(f);
     }
     out.removed += cut.len();
+    let open = s
+        .boundary
+        .edges()
+        .filter(|&(a, b)| s.rim[a as usize] == Rim::Open && s.rim[b as usize] == Rim::Open)
+        .count();
     let Stitcher {
         pos,
         nrm,
@@ -527,7 +536,7 @@ pub(crate) fn stitch<T: Scalar, F: NormalField<T>>(
     mesh.normals = nrm;
     mesh.provenance = prov;
     mesh.triangles = tris;
-    out
+    (out, open)
 }
 
 /// A candidate's remembered score (see [`Stitcher::refresh_score`]).
@@ -652,7 +661,6 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
         // unless one lies right next to the mesh or to another one kept (a near-duplicate
         // would only make slivers): where fronts met and the chart's triangles were dropped,
         // the front then advances through the samples instead of placing points of its own.
-        let mut kept = PointGrid::new(cell);
         let mut is_free = vec![false; n];
         for &(v, h) in free {
             let p = pos[v as usize];
@@ -661,11 +669,12 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
             faces.near(&[p.map(|x| x - r), p.map(|x| x + r), p], |f| {
                 near = near || point_triangle_distance(p, corners(&pos, tris[f as usize])) < r;
             });
-            kept.near(p, r, |w| near = near || dist(pos[w as usize], p) < r);
+            points.near(p, r, |w| {
+                near = near || is_free[w as usize] && dist(pos[w as usize], p) < r;
+            });
             if !near && h > 0.0 {
                 boundary.set_scale(v, h);
                 points.insert(v, p);
-                kept.insert(v, p);
                 is_free[v as usize] = true;
             }
         }
