@@ -12,8 +12,8 @@
 //! | linear invariants with non-zero angles (non-integrable) | valid, at least 200 triangles; at most a fifth `MeshError::Empty` |
 //! | 18-number Hamiltonian invariants, entries in [−1, 1] | valid, at least 200 triangles |
 //! | 12-number Hamiltonian invariants with diagonal `A` (cubics) | valid, vertices on the level set; at most a fifth `MeshError::Empty` |
-//! | tori (a `FnField`) | valid; closed with χ = 0 in at least 75% of cases |
-//! | tori with an elliptic tube about a tilted axis (a `FnField`) | valid; closed with χ = 0 in at least 75% of cases (ignored: 14 of 24 close with its seed) |
+//! | tori (a `FnField`) | valid; closed with χ = 0 in at least 95% of cases |
+//! | tori with an elliptic tube about a tilted axis (a `FnField`) | valid; closed with χ = 0 in at least 90% of cases |
 //!
 //! "Valid" is [`liemesh::mesh::Validation::is_valid`]: manifold, consistently oriented, no
 //! degenerate face and no self-intersection, decided exactly. The mesher itself refuses to
@@ -44,12 +44,12 @@ const HAMILTONIAN_POINTS: usize = 40_000;
 /// and 0 of 256 cases with these seeds, see docs/status.md. Every mesh must still be valid.
 const BAND_MISSES: u32 = 5;
 
-/// The share of round tori (in percent) allowed to come out valid but not closed (an open tube,
-/// or one hole left where fronts met): measured at 10 of 256 cases, see docs/status.md.
-const TORUS_MISSES: u32 = 10;
+/// The share of round tori (in percent) allowed to come out valid but not closed (a few small
+/// holes left where fronts met): measured at 4 of 256 cases, see docs/status.md.
+const TORUS_MISSES: u32 = 5;
 
-/// The same for tilted tori with an elliptic tube: measured at 12 of 64 cases.
-const TILTED_TORUS_MISSES: u32 = 25;
+/// The same for tilted tori with an elliptic tube: measured at 10 of 256 cases.
+const TILTED_TORUS_MISSES: u32 = 10;
 
 fn runner(seed: u64) -> TestRunner {
     let mut config = Config {
@@ -493,9 +493,10 @@ fn on_torus(big: f64, a: f64, b: f64, tilt: f64, u: f64, v: f64) -> [f64; 3] {
 }
 
 /// The largest relative drift `|F − 1|` off a torus: the chord rule is exact for cubic
-/// potentials only, and the torus's is not one (measured: up to 1.5·10⁻⁴ over 256 round and
-/// 256 tilted elliptic tori, on thin tubes where the steps are long against the tube).
-const TORUS_DRIFT: f64 = 3e-4;
+/// potentials only, and the torus's is not one (measured: up to 3.1·10⁻⁴ over 256 round and
+/// 256 tilted elliptic tori, on thin or flattened tubes where the steps and the stitching's
+/// chords are long against the tube).
+const TORUS_DRIFT: f64 = 5e-4;
 
 fn torus_class(seed: u64, elliptic: bool) -> u32 {
     let tau = std::f64::consts::TAU;
@@ -549,7 +550,6 @@ fn tori_close_with_euler_characteristic_zero() {
 }
 
 #[test]
-#[ignore = "open: 12 of 64 tilted elliptic tori stay open; see docs/status.md"]
 fn tilted_elliptic_tori_close_with_euler_characteristic_zero() {
     tolerating(TILTED_TORUS_MISSES, || torus_class(0x7052, true));
 }

@@ -33,6 +33,13 @@
 //! thin torus's ring), instead of growing its own points across it; the try with less open
 //! boundary is kept (`triangulate::stitch`).
 //!
+//! Where holes are left that no ear closes (triangles twisted around them), the triangles
+//! around them are removed and the front runs again, over a few rounds that each open one ring
+//! wider. A round may leave more open than the one before (a twist that re-forms farther out),
+//! so the stitching goes back to its best round before the last step below, and back to
+//! before that step if it leaves a worse state than it found: better is no more boundary loops
+//! and no more edges on holes between fronts that met, and fewer of one.
+//!
 //! Holes that the front leaves open between fronts that met (no vertex of theirs ended a curve
 //! on a terminal condition) are, on an integrable field, filled through a chart of their own at
 //! the end: the hole's loop is projected onto the plane across its mean field normal,
@@ -422,6 +429,7 @@ pub(crate) fn stitch<T: Scalar, F: NormalField<T>>(
     // The vertices whose boundary edges the next round looks at (all, at first; around the
     // holes that were opened, later).
     let mut opened: Option<HashSet<u32, FastHash>> = None;
+    let mut best: Option<Snapshot> = None;
     for round in 0..=REDO_ROUNDS {
         // (Each free vertex takes about two triangles to take in.)
         let budget = 8 * (s.boundary_edges() + 2 * s.free_left()) + 64;
@@ -502,13 +510,29 @@ pub(crate) fn stitch<T: Scalar, F: NormalField<T>>(
         if stuck.is_empty() {
             break;
         }
+        // Opening may leave more than it closes (a twist that re-forms a ring farther out):
+        // the best state so far is kept to fall back on.
+        let open_now = s.open_boundary();
+        if best.as_ref().is_none_or(|b| open_now.better_than(&b.open)) {
+            best = Some(s.snapshot(&out));
+        }
         let (removed, near) = s.open_around(&stuck, round + 1);
         out.removed += removed.len();
         opened = Some(near);
     }
+    // Back to the best state if the last rounds left a worse one.
+    if let Some(best) = best.filter(|b| b.open.better_than(&s.open_boundary())) {
+        (s, out) = s.restore(best, mesh, rim, free);
+    }
     // Holes that are still open between fronts that met are filled through charts of their
-    // own, opened wider where that fails.
+    // own, opened wider where that fails; if that leaves a worse state than before (holes
+    // whose charts never fit stay opened), the state before goes back.
+    let before_charts =
+        (s.growth.new_points && s.open_boundary().hole_edges > 0).then(|| s.snapshot(&out));
     out.added += s.fill_holes_by_chart(&mut out);
+    if let Some(before) = before_charts.filter(|b| b.open.better_than(&s.open_boundary())) {
+        (s, out) = s.restore(before, mesh, rim, free);
+    }
     // Pinches left after the last round are cut apart (only stitched triangles' vertices can
     // be pinched).
     let touched = s.touched();
@@ -537,6 +561,37 @@ pub(crate) fn stitch<T: Scalar, F: NormalField<T>>(
     mesh.provenance = prov;
     mesh.triangles = tris;
     (out, open)
+}
+
+/// What is left open (see [`Stitcher::open_boundary`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+struct OpenBoundary {
+    /// Boundary components: the surface's own boundary and every hole.
+    loops: usize,
+    /// Edges on holes between fronts that met.
+    hole_edges: usize,
+}
+
+impl OpenBoundary {
+    /// Whether this is nearer closing than `other` on both counts and strictly on one: a
+    /// state with fewer but larger holes, or more but smaller ones, is not.
+    fn better_than(&self, other: &OpenBoundary) -> bool {
+        (self.loops, self.hole_edges) != (other.loops, other.hole_edges)
+            && self.loops <= other.loops
+            && self.hole_edges <= other.hole_edges
+    }
+}
+
+/// The stitching's triangles and vertex count at one moment, to fall back on (see
+/// [`Stitcher::restore`]).
+struct Snapshot {
+    /// The triangles ([`DEAD`] where removed).
+    tris: Vec<[u32; 3]>,
+    vertices: usize,
+    /// Its [`Stitcher::open_boundary`].
+    open: OpenBoundary,
+    /// What the stitching had done until then.
+    out: Stitched,
 }
 
 /// A candidate's remembered score (see [`Stitcher::refresh_score`]).
@@ -701,6 +756,97 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
             epoch: Vec::new(),
             free: is_free,
         }
+    }
+
+    /// The boundary's components (edges linked by their vertices), and how many edges are
+    /// on holes between fronts that met and were not stitched: components whose every vertex
+    /// is [`Rim::Open`]. A hole opened until it reaches the surface's own boundary (a cone's
+    /// apex) is part of that boundary, no longer a hole.
+    fn open_boundary(&self) -> OpenBoundary {
+        let edges: Vec<(u32, u32)> = self.boundary.edges().collect();
+        let mut parent: HashMap<u32, u32, FastHash> = HashMap::default();
+        fn root(parent: &mut HashMap<u32, u32, FastHash>, mut v: u32) -> u32 {
+            while let Some(&p) = parent.get(&v) {
+                if p == v {
+                    break;
+                }
+                let up = parent.get(&p).copied().unwrap_or(p);
+                parent.insert(v, up);
+                v = up;
+            }
+            v
+        }
+        for &(a, b) in &edges {
+            parent.entry(a).or_insert(a);
+            parent.entry(b).or_insert(b);
+            let (ra, rb) = (root(&mut parent, a), root(&mut parent, b));
+            if ra != rb {
+                parent.insert(ra.max(rb), ra.min(rb));
+            }
+        }
+        let mut rimmed: HashSet<u32, FastHash> = HashSet::default();
+        let mut components: HashSet<u32, FastHash> = HashSet::default();
+        for &(a, _) in &edges {
+            let r = root(&mut parent, a);
+            components.insert(r);
+            if self.rim[a as usize] != Rim::Open {
+                rimmed.insert(r);
+            }
+        }
+        let hole_edges = edges
+            .iter()
+            .filter(|&&(a, _)| !rimmed.contains(&root(&mut parent, a)))
+            .count();
+        OpenBoundary {
+            loops: components.len(),
+            hole_edges,
+        }
+    }
+
+    /// The state to fall back on, with `out` so far.
+    fn snapshot(&self, out: &Stitched) -> Snapshot {
+        Snapshot {
+            tris: self.tris.clone(),
+            vertices: self.pos.len(),
+            open: self.open_boundary(),
+            out: *out,
+        }
+    }
+
+    /// A stitcher started anew from `snapshot`: its triangles and the vertices there were
+    /// then (later ones are on none of its triangles), with `mesh`, `rim` and `free` as given
+    /// to [`stitch`]; and what the stitching had done until then.
+    fn restore(
+        self,
+        snapshot: Snapshot,
+        mesh: &mut Mesh,
+        rim: &[Rim],
+        free: &[(u32, f64)],
+    ) -> (Self, Stitched) {
+        let initial = snapshot.tris[..self.initial]
+            .iter()
+            .filter(|t| **t != DEAD)
+            .count();
+        let Stitcher {
+            mut pos,
+            mut nrm,
+            mut prov,
+            work,
+            growth,
+            ..
+        } = self;
+        pos.truncate(snapshot.vertices);
+        nrm.truncate(snapshot.vertices);
+        prov.truncate(snapshot.vertices);
+        work.truncate(snapshot.vertices);
+        mesh.vertices = pos;
+        mesh.normals = nrm;
+        mesh.provenance = prov;
+        mesh.triangles = snapshot.tris.into_iter().filter(|t| *t != DEAD).collect();
+        let mut s = Stitcher::new(mesh, work, rim, free, growth);
+        // (The chart's triangles come first and keep their order.)
+        s.initial = initial;
+        (s, snapshot.out)
     }
 
     fn boundary_edges(&self) -> usize {
