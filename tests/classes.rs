@@ -13,7 +13,7 @@
 //! | 18-number Hamiltonian invariants, entries in [−1, 1] | valid, at least 200 triangles |
 //! | 12-number Hamiltonian invariants with diagonal `A` (cubics) | valid, vertices on the level set; at most a fifth `MeshError::Empty` |
 //! | tori (a `FnField`) | valid; closed with χ = 0 in at least 95% of cases |
-//! | tori with an elliptic tube about a tilted axis (a `FnField`) | valid; closed with χ = 0 in at least 90% of cases |
+//! | tori with an elliptic tube about a tilted axis (a `FnField`) | valid; closed with χ = 0 in at least 95% of cases |
 //!
 //! "Valid" is [`liemesh::mesh::Validation::is_valid`]: manifold, consistently oriented, no
 //! degenerate face and no self-intersection, decided exactly. The mesher itself refuses to
@@ -45,11 +45,12 @@ const HAMILTONIAN_POINTS: usize = 40_000;
 const BAND_MISSES: u32 = 5;
 
 /// The share of round tori (in percent) allowed to come out valid but not closed (a few small
-/// holes left where fronts met): measured at 4 of 256 cases, see docs/status.md.
+/// holes left where fronts met, or an open tube): measured at 3 of 256 cases, see
+/// docs/status.md.
 const TORUS_MISSES: u32 = 5;
 
-/// The same for tilted tori with an elliptic tube: measured at 10 of 256 cases.
-const TILTED_TORUS_MISSES: u32 = 10;
+/// The same for tilted tori with an elliptic tube: measured at 6 of 256 cases.
+const TILTED_TORUS_MISSES: u32 = 5;
 
 fn runner(seed: u64) -> TestRunner {
     let mut config = Config {

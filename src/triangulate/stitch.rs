@@ -35,10 +35,11 @@
 //!
 //! Where holes are left that no ear closes (triangles twisted around them), the triangles
 //! around them are removed and the front runs again, over a few rounds that each open one ring
-//! wider. A round may leave more open than the one before (a twist that re-forms farther out),
-//! so the stitching goes back to its best round before the last step below, and back to
-//! before that step if it leaves a worse state than it found: better is no more boundary loops
-//! and no more edges on holes between fronts that met, and fewer of one.
+//! wider. A round may leave more open than the one before (a twist that re-forms farther out):
+//! better is no more boundary loops and no more edges on holes between fronts that met, and
+//! fewer of one. When the last round is worse than the best one, both go through the step
+//! below and the result nearer closing (fewer loops, then fewer hole edges) is kept; that step
+//! itself is taken back where it leaves a worse state than it found.
 //!
 //! Holes that the front leaves open between fronts that met (no vertex of theirs ended a curve
 //! on a terminal condition) are, on an integrable field, filled through a chart of their own at
@@ -429,7 +430,7 @@ pub(crate) fn stitch<T: Scalar, F: NormalField<T>>(
     // The vertices whose boundary edges the next round looks at (all, at first; around the
     // holes that were opened, later).
     let mut opened: Option<HashSet<u32, FastHash>> = None;
-    let mut best: Option<Snapshot> = None;
+    let mut best: Option<Snapshot<T>> = None;
     for round in 0..=REDO_ROUNDS {
         // (Each free vertex takes about two triangles to take in.)
         let budget = 8 * (s.boundary_edges() + 2 * s.free_left()) + 64;
@@ -520,18 +521,24 @@ pub(crate) fn stitch<T: Scalar, F: NormalField<T>>(
         out.removed += removed.len();
         opened = Some(near);
     }
-    // Back to the best state if the last rounds left a worse one.
-    if let Some(best) = best.filter(|b| b.open.better_than(&s.open_boundary())) {
-        (s, out) = s.restore(best, mesh, rim, free);
-    }
     // Holes that are still open between fronts that met are filled through charts of their
-    // own, opened wider where that fails; if that leaves a worse state than before (holes
-    // whose charts never fit stay opened), the state before goes back.
-    let before_charts =
-        (s.growth.new_points && s.open_boundary().hole_edges > 0).then(|| s.snapshot(&out));
-    out.added += s.fill_holes_by_chart(&mut out);
-    if let Some(before) = before_charts.filter(|b| b.open.better_than(&s.open_boundary())) {
-        (s, out) = s.restore(before, mesh, rim, free);
+    // own. If the last rounds left a worse state than the best one, both go through the
+    // charts and the result nearer closing is kept: the charts may merge the last state's
+    // larger holes into the surface's boundary (a cone's apex), or close the best state's
+    // small ones.
+    match best.filter(|b| b.open.better_than(&s.open_boundary())) {
+        None => (s, out) = s.charts_or_keep(out, mesh, rim, free),
+        Some(best) => {
+            let last = s.snapshot(&out);
+            (s, out) = s.restore(best, mesh, rim, free);
+            (s, out) = s.charts_or_keep(out, mesh, rim, free);
+            let from_best = s.snapshot(&out);
+            (s, out) = s.restore(last, mesh, rim, free);
+            (s, out) = s.charts_or_keep(out, mesh, rim, free);
+            if from_best.open.closer_than(&s.open_boundary()) {
+                (s, out) = s.restore(from_best, mesh, rim, free);
+            }
+        }
     }
     // Pinches left after the last round are cut apart (only stitched triangles' vertices can
     // be pinched).
@@ -580,14 +587,22 @@ impl OpenBoundary {
             && self.loops <= other.loops
             && self.hole_edges <= other.hole_edges
     }
+
+    /// Whether this has fewer boundary loops than `other`, or as many and fewer hole edges.
+    fn closer_than(&self, other: &OpenBoundary) -> bool {
+        (self.loops, self.hole_edges) < (other.loops, other.hole_edges)
+    }
 }
 
-/// The stitching's triangles and vertex count at one moment, to fall back on (see
+/// The stitching's triangles and vertices at one moment, to fall back on (see
 /// [`Stitcher::restore`]).
-struct Snapshot {
+struct Snapshot<T> {
     /// The triangles ([`DEAD`] where removed).
     tris: Vec<[u32; 3]>,
-    vertices: usize,
+    pos: Vec<[f64; 3]>,
+    nrm: Vec<[f64; 3]>,
+    prov: Vec<Provenance>,
+    work: Vec<Vec3<T>>,
     /// Its [`Stitcher::open_boundary`].
     open: OpenBoundary,
     /// What the stitching had done until then.
@@ -804,21 +819,23 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
     }
 
     /// The state to fall back on, with `out` so far.
-    fn snapshot(&self, out: &Stitched) -> Snapshot {
+    fn snapshot(&self, out: &Stitched) -> Snapshot<T> {
         Snapshot {
             tris: self.tris.clone(),
-            vertices: self.pos.len(),
+            pos: self.pos.clone(),
+            nrm: self.nrm.clone(),
+            prov: self.prov.clone(),
+            work: self.work.clone(),
             open: self.open_boundary(),
             out: *out,
         }
     }
 
-    /// A stitcher started anew from `snapshot`: its triangles and the vertices there were
-    /// then (later ones are on none of its triangles), with `mesh`, `rim` and `free` as given
-    /// to [`stitch`]; and what the stitching had done until then.
+    /// A stitcher started anew from `snapshot`, with `mesh`, `rim` and `free` as given to
+    /// [`stitch`]; and what the stitching had done until then.
     fn restore(
         self,
-        snapshot: Snapshot,
+        snapshot: Snapshot<T>,
         mesh: &mut Mesh,
         rim: &[Rim],
         free: &[(u32, f64)],
@@ -827,26 +844,34 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
             .iter()
             .filter(|t| **t != DEAD)
             .count();
-        let Stitcher {
-            mut pos,
-            mut nrm,
-            mut prov,
-            work,
-            growth,
-            ..
-        } = self;
-        pos.truncate(snapshot.vertices);
-        nrm.truncate(snapshot.vertices);
-        prov.truncate(snapshot.vertices);
-        work.truncate(snapshot.vertices);
-        mesh.vertices = pos;
-        mesh.normals = nrm;
-        mesh.provenance = prov;
+        let Stitcher { work, growth, .. } = self;
+        *work = snapshot.work;
+        mesh.vertices = snapshot.pos;
+        mesh.normals = snapshot.nrm;
+        mesh.provenance = snapshot.prov;
         mesh.triangles = snapshot.tris.into_iter().filter(|t| *t != DEAD).collect();
         let mut s = Stitcher::new(mesh, work, rim, free, growth);
         // (The chart's triangles come first and keep their order.)
         s.initial = initial;
         (s, snapshot.out)
+    }
+
+    /// [`Self::fill_holes_by_chart`], or the state before it if it leaves a worse one (holes
+    /// whose charts never fit stay opened).
+    fn charts_or_keep(
+        mut self,
+        mut out: Stitched,
+        mesh: &mut Mesh,
+        rim: &[Rim],
+        free: &[(u32, f64)],
+    ) -> (Self, Stitched) {
+        let before = (self.growth.new_points && self.open_boundary().hole_edges > 0)
+            .then(|| self.snapshot(&out));
+        out.added += self.fill_holes_by_chart(&mut out);
+        match before.filter(|b| b.open.better_than(&self.open_boundary())) {
+            Some(before) => self.restore(before, mesh, rim, free),
+            None => (self, out),
+        }
     }
 
     fn boundary_edges(&self) -> usize {
