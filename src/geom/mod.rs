@@ -7,6 +7,7 @@ pub(crate) mod intersect;
 pub(crate) mod predicates;
 pub(crate) mod rng;
 pub(crate) mod rows;
+pub(crate) mod union_find;
 pub(crate) mod vec3;
 
 use crate::scalar::Vec3;

@@ -18,6 +18,7 @@ use crate::geom::grid::{cell_size, radix_sort, spatial_order, Aabb, PairGrid};
 use crate::geom::intersect::{is_collinear, planar_faces_intersect, PlanarFace};
 use crate::geom::predicates::{scale, Checked, Exponents, InRange, Orient, P3};
 use crate::geom::rows::rows_by_corner;
+use crate::geom::union_find::UnionFind;
 use crate::par;
 use std::fmt;
 
@@ -261,29 +262,6 @@ impl fmt::Display for Validation {
     }
 }
 
-/// Disjoint sets over `0..n` (path halving; the lower root wins, for stable roots).
-struct UnionFind(Vec<u32>);
-
-impl UnionFind {
-    fn new(n: usize) -> UnionFind {
-        UnionFind((0..n as u32).collect())
-    }
-    fn find(&mut self, mut x: u32) -> u32 {
-        while self.0[x as usize] != x {
-            let up = self.0[self.0[x as usize] as usize];
-            self.0[x as usize] = up;
-            x = up;
-        }
-        x
-    }
-    fn union(&mut self, a: u32, b: u32) {
-        let (a, b) = (self.find(a), self.find(b));
-        if a != b {
-            self.0[a.max(b) as usize] = a.min(b);
-        }
-    }
-}
-
 /// Sorts a short slice in place (a vertex's edges: about a dozen), falling back to the
 /// library sort for long ones.
 fn insertion_sort(v: &mut [u64]) {
@@ -446,7 +424,7 @@ fn topology(faces: &[[u32; 3]], n: usize, old_vertex: &[u32], v: &mut Validation
     // Scratch: the edges at a vertex, packed as far end w (high 32 bits), local slot, and
     // whether the face runs v → w (lowest bit), so that sorting groups them by edge.
     let mut ends: Vec<u64> = Vec::new();
-    let mut local = UnionFind(Vec::new());
+    let mut local = UnionFind::new(0);
     let mut root_fan: Vec<u32> = Vec::new();
     for vtx in 0..n {
         let (s, e) = (start[vtx] as usize, start[vtx + 1] as usize);
@@ -470,8 +448,7 @@ fn topology(faces: &[[u32; 3]], n: usize, old_vertex: &[u32], v: &mut Validation
             ends.push((prev as u64) << 32 | slot);
         }
         insertion_sort(&mut ends);
-        local.0.clear();
-        local.0.extend(0..(e - s) as u32);
+        local.reset(e - s);
         let slot_of = |x: u64| (x as u32) >> 1;
         let mut i = 0;
         while i < ends.len() {

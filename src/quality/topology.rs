@@ -1,5 +1,6 @@
 //! Topology of a triangle mesh: manifoldness, orientation, boundary, Euler characteristic.
 
+use crate::geom::union_find::UnionFind;
 use crate::triangulate::Mesh;
 use std::collections::HashMap;
 
@@ -68,7 +69,7 @@ impl Topology {
                 _ => non_manifold += 1,
             }
         }
-        let boundary_loops = count_loops(&boundary);
+        let boundary_loops = count_loops(&boundary, mesh.vertices.len());
         let vertices = used.iter().filter(|&&u| u).count();
         let faces = mesh.triangles.len() - degenerate;
         let euler = vertices as i64 - edges.len() as i64 + faces as i64;
@@ -87,35 +88,13 @@ impl Topology {
     }
 }
 
-/// Connected components of the boundary-edge graph.
-fn count_loops(edges: &[(u32, u32)]) -> usize {
-    let mut parent: HashMap<u32, u32> = HashMap::new();
-    fn find(parent: &mut HashMap<u32, u32>, x: u32) -> u32 {
-        let mut r = x;
-        while let Some(&p) = parent.get(&r) {
-            if p == r {
-                break;
-            }
-            r = p;
-        }
-        let mut y = x;
-        while y != r {
-            let next = parent[&y];
-            parent.insert(y, r);
-            y = next;
-        }
-        r
-    }
+/// Connected components of the boundary-edge graph over vertices `0..n`.
+fn count_loops(edges: &[(u32, u32)], n: usize) -> usize {
+    let mut sets = UnionFind::new(n);
     for &(a, b) in edges {
-        parent.entry(a).or_insert(a);
-        parent.entry(b).or_insert(b);
-        let (ra, rb) = (find(&mut parent, a), find(&mut parent, b));
-        if ra != rb {
-            parent.insert(ra.max(rb), ra.min(rb));
-        }
+        sets.union(a, b);
     }
-    let keys: Vec<u32> = parent.keys().copied().collect();
-    let mut roots: Vec<u32> = keys.into_iter().map(|k| find(&mut parent, k)).collect();
+    let mut roots: Vec<u32> = edges.iter().map(|&(a, _)| sets.find(a)).collect();
     roots.sort_unstable();
     roots.dedup();
     roots.len()

@@ -27,7 +27,7 @@ pub use refine::{Refinement, MAX_REFINE_ROUNDS};
 pub(crate) use relax::relax;
 pub(crate) use stitch::unpinch;
 pub use stitch::Stitched;
-pub(crate) use untangle::{drop_unused, keep_main_component, untangle, Before};
+pub(crate) use untangle::{drop_unused, drop_unused_in, keep_main_component, untangle, Before};
 pub use untangle::{Untangled, UNTANGLE_ROUNDS};
 
 #[cfg(test)]
@@ -228,7 +228,7 @@ pub(crate) fn stitch<T: Scalar, F: NormalField<T>>(
     let (again, open_again) =
         stitch::stitch(&mut retry, &mut retry_vertices, &retry_rim, &free, &growth);
     if open_again < open {
-        drop_free_left(
+        drop_unused_in(
             &mut retry,
             &mut retry_vertices,
             first_free..first_free + free.len(),
@@ -238,39 +238,6 @@ pub(crate) fn stitch<T: Scalar, F: NormalField<T>>(
         again
     } else {
         stitched
-    }
-}
-
-/// Takes the vertices in `range` that are on no triangle out of `mesh` and `vertices`,
-/// renumbering the rest.
-fn drop_free_left<T>(mesh: &mut Mesh, vertices: &mut Vec<Vec3<T>>, range: std::ops::Range<usize>) {
-    if range.is_empty() {
-        return;
-    }
-    let mut used = vec![false; mesh.vertices.len()];
-    for t in &mesh.triangles {
-        for &v in t {
-            used[v as usize] = true;
-        }
-    }
-    let mut remap = vec![u32::MAX; mesh.vertices.len()];
-    let mut next = 0usize;
-    for i in 0..mesh.vertices.len() {
-        if used[i] || !range.contains(&i) {
-            remap[i] = next as u32;
-            mesh.vertices[next] = mesh.vertices[i];
-            mesh.normals[next] = mesh.normals[i];
-            mesh.provenance[next] = mesh.provenance[i];
-            vertices.swap(next, i);
-            next += 1;
-        }
-    }
-    mesh.vertices.truncate(next);
-    mesh.normals.truncate(next);
-    mesh.provenance.truncate(next);
-    vertices.truncate(next);
-    for t in &mut mesh.triangles {
-        *t = t.map(|v| remap[v as usize]);
     }
 }
 

@@ -55,6 +55,7 @@
 
 use crate::geom::intersect::faces_intersect;
 use crate::geom::rows::{compressed_rows, rows_by_corner};
+use crate::geom::union_find::UnionFind;
 use crate::geom::vec3::{cross, dist, dot, sub, FastHash};
 use crate::mesh::{Mesh, Provenance};
 use crate::scalar::{Scalar, Vec3};
@@ -779,42 +780,25 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
     /// apex) is part of that boundary, no longer a hole.
     fn open_boundary(&self) -> OpenBoundary {
         let edges: Vec<(u32, u32)> = self.boundary.edges().collect();
-        let mut parent: HashMap<u32, u32, FastHash> = HashMap::default();
-        fn root(parent: &mut HashMap<u32, u32, FastHash>, mut v: u32) -> u32 {
-            while let Some(&p) = parent.get(&v) {
-                if p == v {
-                    break;
-                }
-                let up = parent.get(&p).copied().unwrap_or(p);
-                parent.insert(v, up);
-                v = up;
-            }
-            v
-        }
+        let mut sets = UnionFind::new(self.pos.len());
         for &(a, b) in &edges {
-            parent.entry(a).or_insert(a);
-            parent.entry(b).or_insert(b);
-            let (ra, rb) = (root(&mut parent, a), root(&mut parent, b));
-            if ra != rb {
-                parent.insert(ra.max(rb), ra.min(rb));
-            }
+            sets.union(a, b);
         }
-        let mut rimmed: HashSet<u32, FastHash> = HashSet::default();
         let mut components: HashSet<u32, FastHash> = HashSet::default();
+        let mut rimmed: HashSet<u32, FastHash> = HashSet::default();
         for &(a, _) in &edges {
-            let r = root(&mut parent, a);
+            let r = sets.find(a);
             components.insert(r);
             if self.rim[a as usize] != Rim::Open {
                 rimmed.insert(r);
             }
         }
-        let hole_edges = edges
-            .iter()
-            .filter(|&&(a, _)| !rimmed.contains(&root(&mut parent, a)))
-            .count();
         OpenBoundary {
             loops: components.len(),
-            hole_edges,
+            hole_edges: edges
+                .iter()
+                .filter(|&&(a, _)| !rimmed.contains(&sets.find(a)))
+                .count(),
         }
     }
 
@@ -2253,23 +2237,15 @@ fn pinched_fans(triangles: &[[u32; 3]], candidate: impl Fn(u32) -> bool) -> (Vec
         });
     let (start, star) = compressed_rows(n, corners).expect("n is above every live corner");
     let (mut pinched, mut drop) = (Vec::new(), Vec::new());
-    let mut group: Vec<usize> = Vec::new();
-    let (mut roots, mut sizes): (Vec<usize>, Vec<(usize, usize)>) = (Vec::new(), Vec::new());
+    let mut group = UnionFind::new(0);
+    let (mut roots, mut sizes): (Vec<u32>, Vec<(u32, usize)>) = (Vec::new(), Vec::new());
     for v in 0..n {
         let faces = &star[start[v] as usize..start[v + 1] as usize];
         if faces.len() < 2 {
             continue;
         }
         // Union of the star's triangles that share an edge at v (a second common vertex).
-        group.clear();
-        group.extend(0..faces.len());
-        fn root(g: &mut [usize], mut i: usize) -> usize {
-            while g[i] != i {
-                g[i] = g[g[i]];
-                i = g[i];
-            }
-            i
-        }
+        group.reset(faces.len());
         // Once every triangle is in one fan (the usual case) there is nothing to find.
         let mut fans = faces.len();
         'pairs: for i in 0..faces.len() {
@@ -2280,14 +2256,10 @@ fn pinched_fans(triangles: &[[u32; 3]], candidate: impl Fn(u32) -> bool) -> (Vec
                     .iter()
                     .filter(|&&w| w != v as u32 && tj.contains(&w))
                     .count();
-                if shared > 0 {
-                    let (a, b) = (root(&mut group, i), root(&mut group, j));
-                    if a != b {
-                        group[a.max(b)] = a.min(b);
-                        fans -= 1;
-                        if fans == 1 {
-                            break 'pairs;
-                        }
+                if shared > 0 && group.union(i as u32, j as u32) {
+                    fans -= 1;
+                    if fans == 1 {
+                        break 'pairs;
                     }
                 }
             }
@@ -2296,7 +2268,7 @@ fn pinched_fans(triangles: &[[u32; 3]], candidate: impl Fn(u32) -> bool) -> (Vec
             continue;
         }
         roots.clear();
-        roots.extend((0..faces.len()).map(|i| root(&mut group, i)));
+        roots.extend((0..faces.len() as u32).map(|i| group.find(i)));
         sizes.clear();
         for &r in &roots {
             match sizes.iter_mut().find(|(g, _)| *g == r) {

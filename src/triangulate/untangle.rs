@@ -15,6 +15,7 @@
 //! after [`UNTANGLE_ROUNDS`] rounds is an error, never an output.
 
 use super::stitch::unpinch;
+use crate::geom::union_find::UnionFind;
 use crate::mesh::Mesh;
 use crate::scalar::{Scalar, Vec3};
 
@@ -105,45 +106,45 @@ pub(crate) fn keep_main_component(mesh: &mut Mesh) {
     let n = mesh.vertices.len();
     // Union–find over vertices joined by edges: faces sharing an edge share two vertices,
     // and a pinch-free mesh's components through vertices and through edges agree.
-    let mut parent: Vec<u32> = (0..n as u32).collect();
-    fn find(parent: &mut [u32], mut x: u32) -> u32 {
-        while parent[x as usize] != x {
-            parent[x as usize] = parent[parent[x as usize] as usize];
-            x = parent[x as usize];
-        }
-        x
-    }
+    let mut parent = UnionFind::new(n);
     for t in tris {
         for k in 0..3 {
-            let (a, b) = (find(&mut parent, t[k]), find(&mut parent, t[(k + 1) % 3]));
-            if a != b {
-                parent[a.max(b) as usize] = a.min(b);
-            }
+            parent.union(t[k], t[(k + 1) % 3]);
         }
     }
     let mut size = vec![0usize; n];
     for t in tris {
-        size[find(&mut parent, t[0]) as usize] += 1;
+        size[parent.find(t[0]) as usize] += 1;
     }
     let p0 = mesh
         .provenance
         .iter()
         .position(|pr| pr.curve == 0 && pr.step == 0)
-        .map(|v| find(&mut parent, v as u32))
+        .map(|v| parent.find(v as u32))
         .filter(|&r| size[r as usize] > 0);
     let keep = p0.unwrap_or_else(|| {
         (0..n as u32)
             .max_by_key(|&r| (size[r as usize], std::cmp::Reverse(r)))
             .unwrap_or(0)
     });
-    mesh.triangles.retain(|t| find(&mut parent, t[0]) == keep);
+    mesh.triangles.retain(|t| parent.find(t[0]) == keep);
 }
 
 /// Drops the vertices no face uses (and their working-precision twins), renumbering the rest
 /// in order.
 pub(crate) fn drop_unused<T>(mesh: &mut Mesh, vertices: &mut Vec<Vec3<T>>) {
+    drop_unused_in(mesh, vertices, 0..mesh.vertices.len());
+}
+
+/// [`drop_unused`] for the vertices in `range` only (the others stay, used or not).
+pub(crate) fn drop_unused_in<T>(
+    mesh: &mut Mesh,
+    vertices: &mut Vec<Vec3<T>>,
+    range: std::ops::Range<usize>,
+) {
     let n = mesh.vertices.len();
-    let mut used = vec![false; n];
+    // (Vertices outside the range count as used.)
+    let mut used: Vec<bool> = (0..n).map(|v| !range.contains(&v)).collect();
     for t in &mesh.triangles {
         for &v in t {
             used[v as usize] = true;
