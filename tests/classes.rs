@@ -364,12 +364,17 @@ fn non_integrable_linear_invariants_sweep_an_embedded_surface() {
                 empty.set(empty.get() + 1);
                 return Ok(());
             }
-            check(
-                &field,
-                p0,
-                Shape::Swept(200),
-                &format!("linear {numbers:?}"),
-            )?;
+            let what = format!("linear {numbers:?}");
+            let run = check(&field, p0, Shape::Swept(200), &what)?;
+            // Stitching a swept surface joins what the curves swept; it never takes away
+            // more triangles than it adds (it cannot place new points to replace them).
+            let s = run.stitched;
+            prop_assert!(
+                s.added >= s.removed,
+                "{what}, p0 {p0:?}: stitching added {} triangles and removed {}",
+                s.added,
+                s.removed
+            );
             Ok(())
         })
         .unwrap();
@@ -386,12 +391,15 @@ fn hamiltonian_invariants_sweep_an_embedded_surface() {
             // and must still be valid and large enough).
             let mut params = MeshParams::at(p0);
             params.max_points = HAMILTONIAN_POINTS;
-            check_with(
-                &field,
-                params,
-                Shape::Swept(200),
-                &format!("Hamiltonian {numbers:?}"),
-            )?;
+            let what = format!("Hamiltonian {numbers:?}");
+            let run = check_with(&field, params, Shape::Swept(200), &what)?;
+            let s = run.stitched;
+            prop_assert!(
+                s.added >= s.removed,
+                "{what}: stitching added {} triangles and removed {}",
+                s.added,
+                s.removed
+            );
             Ok(())
         })
         .unwrap();
