@@ -279,9 +279,17 @@ pub fn run_observed<T: Scalar, F: NormalField<T>>(
         curves,
         mesh.triangles.len(),
     ));
-    triangulate::unpinch(&mut mesh.triangles);
-    triangulate::keep_main_component(&mut mesh);
+    // Pinched vertices are cut apart and only the main component is kept; the validation
+    // finds both, so on the usual mesh, which has neither, those passes are skipped.
     let mut validation = mesh.validate();
+    let pinched = !validation.non_manifold_vertices.is_empty()
+        || !validation.degenerate_faces.is_empty()
+        || !validation.out_of_range_faces.is_empty();
+    if pinched || validation.components > 1 {
+        triangulate::unpinch(&mut mesh.triangles);
+        triangulate::keep_main_component(&mut mesh);
+        validation = mesh.validate();
+    }
     let mut untangled = triangulate::Untangled::default();
     if !validation.self_intersections.is_empty() {
         untangled = triangulate::untangle(&mut mesh, &mut vertices, before.as_ref(), |p, t| {
