@@ -6,7 +6,9 @@
 //! a non-integrable field's sweep). Here the crossings are found exactly, over the whole mesh,
 //! and undone:
 //!
-//! 1. vertices of crossing faces that relaxation moved go back to where they were before it;
+//! 1. vertices of crossing faces that relaxation moved go back to where they were before it
+//!    (a round of that which leaves no fewer crossings is taken back: the flips after
+//!    relaxation may have joined those vertices differently);
 //! 2. faces that still cross are removed — on a non-integrable field the swept surface ends
 //!    where it would cross itself —, pinched vertices are cut apart, and only the component of
 //!    `p0` (or the largest) is kept.
@@ -45,8 +47,29 @@ pub(crate) fn untangle<T: Scalar>(
 ) -> Untangled {
     let mut done = Untangled::default();
     let mut reverting = before.is_some();
+    // The state before the last round of reverts, with its crossings: reverts judged face by
+    // face can make things worse (the flips after relaxation changed which vertices a face
+    // has), and then they are taken back and the faces removed instead.
+    type Undo<T> = (
+        Vec<[f64; 3]>,
+        Vec<[f64; 3]>,
+        Vec<Vec3<T>>,
+        Vec<(usize, usize)>,
+    );
+    let mut undo: Option<Undo<T>> = None;
+    let mut last_moved = 0;
     for _ in 0..UNTANGLE_ROUNDS {
-        let pairs = crossings(&mesh.vertices, &mesh.triangles);
+        let mut pairs = crossings(&mesh.vertices, &mesh.triangles);
+        if let Some((positions, normals, working, earlier)) = undo.take() {
+            if pairs.len() >= earlier.len() {
+                mesh.vertices = positions;
+                mesh.normals = normals;
+                vertices.clone_from_slice(&working);
+                pairs = earlier;
+                done.reverted -= last_moved;
+                reverting = false;
+            }
+        }
         done.left = pairs.len();
         if pairs.is_empty() {
             return done;
@@ -55,6 +78,12 @@ pub(crate) fn untangle<T: Scalar>(
         faces.sort_unstable();
         faces.dedup();
         if let (true, Some(b)) = (reverting, before) {
+            undo = Some((
+                mesh.vertices.clone(),
+                mesh.normals.clone(),
+                vertices.to_vec(),
+                pairs,
+            ));
             let mut moved = 0;
             for &f in &faces {
                 for v in mesh.triangles[f] {
@@ -68,9 +97,11 @@ pub(crate) fn untangle<T: Scalar>(
                 }
             }
             done.reverted += moved;
+            last_moved = moved;
             if moved > 0 {
                 continue;
             }
+            undo = None;
             reverting = false;
         }
         let drop: std::collections::HashSet<usize> = faces.into_iter().collect();
