@@ -279,13 +279,15 @@ pub fn run_observed<T: Scalar, F: NormalField<T>>(
         curves,
         mesh.triangles.len(),
     ));
-    // Pinched vertices are cut apart and only the main component is kept; the validation
-    // finds both, so on the usual mesh, which has neither, those passes are skipped.
+    // Pinched vertices are cut apart and only the main component is kept. The validation
+    // finds both (and the faces it leaves out of its topology, which those passes may drop),
+    // so on the usual mesh, which has none of them, the passes are skipped.
     let mut validation = mesh.validate();
-    let pinched = !validation.non_manifold_vertices.is_empty()
+    let untidy = !validation.non_manifold_vertices.is_empty()
         || !validation.degenerate_faces.is_empty()
-        || !validation.out_of_range_faces.is_empty();
-    if pinched || validation.components > 1 {
+        || !validation.out_of_range_faces.is_empty()
+        || validation.components > 1;
+    if untidy {
         triangulate::unpinch(&mut mesh.triangles);
         triangulate::keep_main_component(&mut mesh);
         validation = mesh.validate();

@@ -343,6 +343,20 @@ fn cones_are_one_nappe() {
     });
 }
 
+/// Stitching a swept (non-integrable) surface joins what the curves swept; it never takes
+/// away more triangles than it adds (it cannot place new points to replace them).
+fn stitching_kept_the_sweep(run: &MeshRun<f64>, what: &str) -> Result<(), TestCaseError> {
+    let s = run.stitched;
+    prop_assert!(
+        s.added >= s.removed,
+        "{what}, p0 {:?}: stitching added {} triangles and removed {}",
+        run.params.given.p0,
+        s.added,
+        s.removed
+    );
+    Ok(())
+}
+
 #[test]
 fn non_integrable_linear_invariants_sweep_an_embedded_surface() {
     let angle = (-1.0f64..1.0).prop_filter("non-zero", |a: &f64| a.abs() > 0.05);
@@ -366,16 +380,7 @@ fn non_integrable_linear_invariants_sweep_an_embedded_surface() {
             }
             let what = format!("linear {numbers:?}");
             let run = check(&field, p0, Shape::Swept(200), &what)?;
-            // Stitching a swept surface joins what the curves swept; it never takes away
-            // more triangles than it adds (it cannot place new points to replace them).
-            let s = run.stitched;
-            prop_assert!(
-                s.added >= s.removed,
-                "{what}, p0 {p0:?}: stitching added {} triangles and removed {}",
-                s.added,
-                s.removed
-            );
-            Ok(())
+            stitching_kept_the_sweep(&run, &what)
         })
         .unwrap();
     at_most_a_fifth_empty(empty.get(), cases, "fields");
@@ -393,14 +398,7 @@ fn hamiltonian_invariants_sweep_an_embedded_surface() {
             params.max_points = HAMILTONIAN_POINTS;
             let what = format!("Hamiltonian {numbers:?}");
             let run = check_with(&field, params, Shape::Swept(200), &what)?;
-            let s = run.stitched;
-            prop_assert!(
-                s.added >= s.removed,
-                "{what}: stitching added {} triangles and removed {}",
-                s.added,
-                s.removed
-            );
-            Ok(())
+            stitching_kept_the_sweep(&run, &what)
         })
         .unwrap();
 }

@@ -37,11 +37,11 @@
 //! around them are removed and the front runs again, over a few rounds that each open one ring
 //! wider (only on an integrable field: without new points the removed triangles could not be
 //! replaced, and a swept surface would only shrink). A round may leave more open than the one
-//! before (a twist that re-forms farther out):
-//! better is no more boundary loops and no more edges on holes between fronts that met, and
-//! fewer of one. When the last round is worse than the best one, both go through the step
-//! below and the result nearer closing (fewer loops, then fewer hole edges) is kept; that step
-//! itself is taken back where it leaves a worse state than it found.
+//! before (a twist that re-forms farther out), so the best state is kept: better is no more
+//! boundary loops and no more edges on holes between fronts that met, and fewer of one. When
+//! the last round is worse than the best one, both go through the step below and the result
+//! nearer closing (fewer loops, then fewer hole edges) is kept; that step itself is taken back
+//! where it leaves a worse state than it found.
 //!
 //! Holes that the front leaves open between fronts that met (no vertex of theirs ended a curve
 //! on a terminal condition) are, on an integrable field, filled through a chart of their own at
@@ -500,8 +500,7 @@ pub(crate) fn stitch<T: Scalar, F: NormalField<T>>(
         // stitching runs again on the larger hole.
         // Without new points (a non-integrable field) an opened hole can only be refilled
         // from the vertices around it: opening ring after ring would take away swept surface
-        // it can never give back (measured: a third of the triangles, and more, on one
-        // random field in three).
+        // it can never give back (one random field lost half its triangles so).
         if round == REDO_ROUNDS || out.budget_hit || !s.growth.new_points {
             break;
         }

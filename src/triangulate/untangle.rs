@@ -47,26 +47,21 @@ pub(crate) fn untangle<T: Scalar>(
 ) -> Untangled {
     let mut done = Untangled::default();
     let mut reverting = before.is_some();
-    // The state before the last round of reverts, with its crossings: reverts judged face by
-    // face can make things worse (the flips after relaxation changed which vertices a face
-    // has), and then they are taken back and the faces removed instead.
-    type Undo<T> = (
-        Vec<[f64; 3]>,
-        Vec<[f64; 3]>,
-        Vec<Vec3<T>>,
-        Vec<(usize, usize)>,
-    );
-    let mut undo: Option<Undo<T>> = None;
-    let mut last_moved = 0;
+    // Reverts judged face by face can make things worse (the flips after relaxation changed
+    // which vertices a face has): a round that leaves no fewer crossings is taken back and
+    // the faces are removed instead.
+    let mut last_round: Option<RevertRound<T>> = None;
     for _ in 0..UNTANGLE_ROUNDS {
         let mut pairs = crossings(&mesh.vertices, &mesh.triangles);
-        if let Some((positions, normals, working, earlier)) = undo.take() {
-            if pairs.len() >= earlier.len() {
-                mesh.vertices = positions;
-                mesh.normals = normals;
-                vertices.clone_from_slice(&working);
-                pairs = earlier;
-                done.reverted -= last_moved;
+        if let Some(round) = last_round.take() {
+            if pairs.len() >= round.crossings.len() {
+                done.reverted -= round.moved.len();
+                for m in round.moved {
+                    mesh.vertices[m.vertex] = m.position;
+                    mesh.normals[m.vertex] = m.normal;
+                    vertices[m.vertex] = m.working;
+                }
+                pairs = round.crossings;
                 reverting = false;
             }
         }
@@ -78,30 +73,31 @@ pub(crate) fn untangle<T: Scalar>(
         faces.sort_unstable();
         faces.dedup();
         if let (true, Some(b)) = (reverting, before) {
-            undo = Some((
-                mesh.vertices.clone(),
-                mesh.normals.clone(),
-                vertices.to_vec(),
-                pairs,
-            ));
-            let mut moved = 0;
+            let mut moved = Vec::new();
             for &f in &faces {
                 for v in mesh.triangles[f] {
                     let v = v as usize;
                     if v < b.positions.len() && mesh.vertices[v] != b.positions[v] {
+                        moved.push(Moved {
+                            vertex: v,
+                            position: mesh.vertices[v],
+                            normal: mesh.normals[v],
+                            working: vertices[v].clone(),
+                        });
                         mesh.vertices[v] = b.positions[v];
                         mesh.normals[v] = b.normals[v];
                         vertices[v] = b.working[v].clone();
-                        moved += 1;
                     }
                 }
             }
-            done.reverted += moved;
-            last_moved = moved;
-            if moved > 0 {
+            if !moved.is_empty() {
+                done.reverted += moved.len();
+                last_round = Some(RevertRound {
+                    moved,
+                    crossings: pairs,
+                });
                 continue;
             }
-            undo = None;
             reverting = false;
         }
         let drop: std::collections::HashSet<usize> = faces.into_iter().collect();
@@ -118,6 +114,21 @@ pub(crate) fn untangle<T: Scalar>(
     }
     done.left = crossings(&mesh.vertices, &mesh.triangles).len();
     done
+}
+
+/// A round of reverts, kept to be taken back: each vertex it moved with its position, normal
+/// and working-precision point until then, and the crossings before it.
+struct RevertRound<T> {
+    moved: Vec<Moved<T>>,
+    crossings: Vec<(usize, usize)>,
+}
+
+/// A vertex a revert moved, and where it was.
+struct Moved<T> {
+    vertex: usize,
+    position: [f64; 3],
+    normal: [f64; 3],
+    working: Vec3<T>,
 }
 
 /// Positions and normals before relaxation.
