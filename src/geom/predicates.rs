@@ -6,7 +6,9 @@
 //! 2⁹¹⁰: far from both ends of the exponent range, so there `robust` is exact ([`InRange`]).
 //! Other inputs are scaled by a power of two (exact, and the signs do not change) when their
 //! spread of exponents fits that window, and otherwise decided with integer arithmetic
-//! ([`Checked`]). Signs are `i8` in {−1, 0, 1}.
+//! ([`Checked`]). In front of both, a floating-point filter whose error bound accounts for
+//! underflow decides most such input at the cost of one plain evaluation. Signs are `i8` in
+//! {−1, 0, 1}.
 
 use robust::{Coord, Coord3D};
 
@@ -157,6 +159,9 @@ impl Orient for Checked {
         {
             return InRange.orient3d(a, b, c, d);
         }
+        if let Some(s) = filter::orient3d(a, b, c, d) {
+            return s;
+        }
         let e = Exponents::of(a.iter().chain(&b).chain(&c).chain(&d).copied());
         match e.plan() {
             Plan::NonFinite => 0,
@@ -171,6 +176,9 @@ impl Orient for Checked {
     fn orient2d(self, a: [f64; 2], b: [f64; 2], c: [f64; 2]) -> i8 {
         if a.iter().chain(&b).chain(&c).all(|&x| surely_in_window(x)) {
             return InRange.orient2d(a, b, c);
+        }
+        if let Some(s) = filter::orient2d(a, b, c) {
+            return s;
         }
         let e = Exponents::of(a.iter().chain(&b).chain(&c).copied());
         match e.plan() {
@@ -308,6 +316,55 @@ pub(crate) fn scale(x: f64, k: i32) -> f64 {
 fn pow2(k: i32) -> f64 {
     let k = k.clamp(-1022, 1023);
     f64::from_bits(((k + 1023) as u64) << 52)
+}
+
+/// A floating-point filter in front of the integer arithmetic: the determinant evaluated in
+/// `f64` with a bound on its error, the sign taken only where the bound decides it.
+///
+/// Outside the window products may underflow, which Shewchuk's relative bound does not cover:
+/// a product that underflows is off by at most half the smallest subnormal (`TINY / 2`),
+/// absolutely, and a difference that underflows is exact. Propagated through the outer
+/// products, that adds at most `TINY · (Σ|uᵢ| + 2)` to orient3d's error (`TINY` to
+/// orient2d's), doubled here for the rounding of the bound itself. Overflow shows as an
+/// infinite bound or a NaN determinant, and then the filter declines, as it does whenever
+/// `|det|` is not above the bound (exact zeros included).
+mod filter {
+    use super::{sign, P3};
+
+    const EPS: f64 = f64::EPSILON / 2.0;
+    /// The smallest positive subnormal, 2⁻¹⁰⁷⁴.
+    const TINY: f64 = f64::from_bits(1);
+    /// Shewchuk's `o3derrboundA` and `ccwerrboundA`.
+    const ORIENT3D_BOUND: f64 = (7.0 + 56.0 * EPS) * EPS;
+    const ORIENT2D_BOUND: f64 = (3.0 + 16.0 * EPS) * EPS;
+
+    /// The sign of `det[b − a, c − a, d − a]` if the filter can certify it.
+    #[inline]
+    pub(super) fn orient3d(a: P3, b: P3, c: P3, d: P3) -> Option<i8> {
+        let u = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
+        let v = [c[0] - a[0], c[1] - a[1], c[2] - a[2]];
+        let w = [d[0] - a[0], d[1] - a[1], d[2] - a[2]];
+        let (p12, p21) = (v[1] * w[2], v[2] * w[1]);
+        let (p02, p20) = (v[0] * w[2], v[2] * w[0]);
+        let (p01, p10) = (v[0] * w[1], v[1] * w[0]);
+        let det = u[0] * (p12 - p21) - u[1] * (p02 - p20) + u[2] * (p01 - p10);
+        let permanent = u[0].abs() * (p12.abs() + p21.abs())
+            + u[1].abs() * (p02.abs() + p20.abs())
+            + u[2].abs() * (p01.abs() + p10.abs());
+        let underflow = 2.0 * TINY * (u[0].abs() + u[1].abs() + u[2].abs() + 2.0);
+        let bound = ORIENT3D_BOUND * permanent + underflow;
+        (det.abs() > bound && bound.is_finite()).then(|| sign(det))
+    }
+
+    /// The sign of `(b − a) × (c − a)` if the filter can certify it.
+    #[inline]
+    pub(super) fn orient2d(a: [f64; 2], b: [f64; 2], c: [f64; 2]) -> Option<i8> {
+        let left = (b[0] - a[0]) * (c[1] - a[1]);
+        let right = (b[1] - a[1]) * (c[0] - a[0]);
+        let det = left - right;
+        let bound = ORIENT2D_BOUND * (left.abs() + right.abs()) + 2.0 * TINY;
+        (det.abs() > bound && bound.is_finite()).then(|| sign(det))
+    }
 }
 
 /// Integer arithmetic for inputs outside the window: every finite `f64` is an integer times
@@ -589,6 +646,72 @@ mod tests {
             );
         }
         assert!(undecided > 1000, "{undecided}");
+    }
+
+    /// Where the filter decides, it agrees with the integer arithmetic: on coordinates spread
+    /// over the whole exponent range (subnormals included), on nearly degenerate input (a
+    /// fourth point a few units in the last place off a plane), and on mesh-like input with a
+    /// few tiny coordinates (what sends a mesh out of the window). It decides most of the
+    /// last kind, which is what makes it worth having.
+    #[test]
+    fn the_filter_agrees_with_the_integers_where_it_decides() {
+        let mut rng = XorShift64::new(11);
+        let signed = |rng: &mut XorShift64, x: f64| if rng.next_u64() % 2 == 0 { x } else { -x };
+        let wild = |rng: &mut XorShift64| match rng.next_u64() % 8 {
+            0 => 0.0,
+            1 => {
+                let x = f64::from_bits(rng.next_u64() % (1 << 20));
+                signed(rng, x)
+            }
+            _ => {
+                let e = (rng.next_u64() % 2090) as i32 - 1070;
+                scale(rng.in_cube(1.0)[0], e.min(1020))
+            }
+        };
+        let (mut decided, mut mesh_like) = (0, 0);
+        for i in 0..30_000 {
+            let mut p: Vec<P3> = (0..4)
+                .map(|_| [wild(&mut rng), wild(&mut rng), wild(&mut rng)])
+                .collect();
+            match i % 3 {
+                0 => {
+                    // Four points in a plane through the origin, the last nudged off it.
+                    let s = scale(1.0, (rng.next_u64() % 1200) as i32 - 600);
+                    for q in p.iter_mut() {
+                        let r = rng.in_cube(1.0);
+                        *q = [r[0] * s, r[1] * s, (r[0] + r[1]) * s];
+                    }
+                    let bits = p[3][2].to_bits();
+                    p[3][2] = f64::from_bits(bits.wrapping_add(rng.next_u64() % 5).wrapping_sub(2));
+                }
+                1 => {
+                    // A mesh at some scale, with a few coordinates far below it.
+                    let s = scale(1.0, (rng.next_u64() % 200) as i32 - 100);
+                    for q in p.iter_mut() {
+                        *q = rng.in_cube(s);
+                        for x in q.iter_mut() {
+                            if rng.next_u64() % 6 == 0 {
+                                let e = -((rng.next_u64() % 1000) as i32) - 100;
+                                *x = scale(*x, e);
+                            }
+                        }
+                    }
+                    mesh_like += 1;
+                }
+                _ => {}
+            }
+            let x = exact::orient3d(p[0], p[1], p[2], p[3]);
+            if let Some(f) = filter::orient3d(p[0], p[1], p[2], p[3]) {
+                assert_eq!(f, x, "{p:?}");
+                decided += (i % 3 == 1) as usize;
+            }
+            let q = |v: P3| [v[0], v[1]];
+            let x2 = exact::orient2d(q(p[0]), q(p[1]), q(p[2]));
+            if let Some(f) = filter::orient2d(q(p[0]), q(p[1]), q(p[2])) {
+                assert_eq!(f, x2, "{p:?}");
+            }
+        }
+        assert!(decided * 10 > mesh_like * 9, "{decided} of {mesh_like}");
     }
 
     /// The three evaluations (robust, robust after scaling, integers) agree on random and on
