@@ -656,7 +656,13 @@ mod tests {
     #[test]
     fn the_filter_agrees_with_the_integers_where_it_decides() {
         let mut rng = XorShift64::new(11);
-        let signed = |rng: &mut XorShift64, x: f64| if rng.next_u64() % 2 == 0 { x } else { -x };
+        let signed = |rng: &mut XorShift64, x: f64| {
+            if rng.next_u64().is_multiple_of(2) {
+                x
+            } else {
+                -x
+            }
+        };
         let wild = |rng: &mut XorShift64| match rng.next_u64() % 8 {
             0 => 0.0,
             1 => {
@@ -690,7 +696,7 @@ mod tests {
                     for q in p.iter_mut() {
                         *q = rng.in_cube(s);
                         for x in q.iter_mut() {
-                            if rng.next_u64() % 6 == 0 {
+                            if rng.next_u64().is_multiple_of(6) {
                                 let e = -((rng.next_u64() % 1000) as i32) - 100;
                                 *x = scale(*x, e);
                             }
