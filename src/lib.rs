@@ -246,6 +246,7 @@ pub fn run_observed<T: Scalar, F: NormalField<T>>(
         positions: mesh.vertices.clone(),
         normals: mesh.normals.clone(),
         working: vertices.clone(),
+        triangles: mesh.triangles.clone(),
     });
     if improve {
         observe(Progress::at(
@@ -254,7 +255,7 @@ pub fn run_observed<T: Scalar, F: NormalField<T>>(
             curves,
             mesh.triangles.len(),
         ));
-        triangulate::relax(field, params, &mut mesh, &mut vertices);
+        triangulate::relax(field, params, &mut mesh, &mut vertices, &[]);
     }
     lap(&mut timings.improving, &mut since);
     let refinement = params.max_normal_error.map(|limit| {
@@ -283,6 +284,21 @@ pub fn run_observed<T: Scalar, F: NormalField<T>>(
     // finds both (and the faces it leaves out of its topology, which those passes may drop),
     // so on the usual mesh, which has none of them, the passes are skipped.
     let mut validation = mesh.validate();
+    // Crossings that relaxation made are first relaxed away again with their vertices pinned
+    // (not after refinement, which added vertices since).
+    let mut pinned = 0;
+    if let (false, Some(b), None) = (
+        validation.self_intersections.is_empty(),
+        before.as_ref(),
+        refinement.as_ref(),
+    ) {
+        pinned = triangulate::relax_pinned(field, params, &mut mesh, &mut vertices, b, |p, t| {
+            mesh::crossings(p, t)
+        });
+        if pinned > 0 {
+            validation = mesh.validate();
+        }
+    }
     let untidy = !validation.non_manifold_vertices.is_empty()
         || !validation.degenerate_faces.is_empty()
         || !validation.out_of_range_faces.is_empty()
@@ -299,6 +315,7 @@ pub fn run_observed<T: Scalar, F: NormalField<T>>(
         });
         validation = mesh.validate();
     }
+    untangled.pinned = pinned;
     triangulate::drop_unused(&mut mesh, &mut vertices);
     // The refinement's count of faces over the bound, on the mesh as returned.
     let mut refinement = refinement;

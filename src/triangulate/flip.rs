@@ -570,12 +570,14 @@ pub(crate) struct FlipPass {
 
 /// Flips edges of `triangles` in place. At most `budget` flips are made. Triangles that do
 /// not form a consistently oriented 2-manifold are left as they are (a flip there could make
-/// an edge non-manifold).
+/// an edge non-manifold). Edges whose quad has a vertex marked in `pinned` (empty: none)
+/// are not flipped.
 pub(crate) fn flip_to_surface_delaunay(
     points: &[[f64; 3]],
     normals: &[[f64; 3]],
     triangles: &mut Vec<[u32; 3]>,
     budget: usize,
+    pinned: &[bool],
 ) -> FlipPass {
     let max_visits = 20 * triangles.len() + 1000;
     let mut he = match HalfEdges::new(std::mem::take(triangles), points.len()) {
@@ -644,6 +646,9 @@ pub(crate) fn flip_to_surface_delaunay(
         }
         let (t1, t2) = (h / 3, g / 3);
         let (c, d) = (he.origin(prev(h)), he.origin(prev(g)));
+        if !pinned.is_empty() && [a, b, c, d].iter().any(|&v| pinned[v as usize]) {
+            continue;
+        }
         let was_folded = folded.get(t1 as usize) || folded.get(t2 as usize);
         if !he.wants_flip(points, normals, [a, b, c, d], was_folded) {
             continue;
@@ -838,7 +843,7 @@ mod tests {
         let p = rhombus();
         let n = vec![[0.0, 0.0, 1.0]; 4];
         let mut t = vec![[0, 1, 2], [0, 2, 3]];
-        let pass = flip_to_surface_delaunay(&p, &n, &mut t, 10);
+        let pass = flip_to_surface_delaunay(&p, &n, &mut t, 10, &[]);
         assert_eq!((pass.flips, pass.folded), (1, Some(false)));
         let mut edges: Vec<_> = t
             .iter()
@@ -847,7 +852,7 @@ mod tests {
         edges.sort_unstable();
         assert!(edges.contains(&(1, 3)) || edges.contains(&(3, 1)));
         // Now Delaunay: a second pass changes nothing.
-        assert_eq!(flip_to_surface_delaunay(&p, &n, &mut t, 10).flips, 0);
+        assert_eq!(flip_to_surface_delaunay(&p, &n, &mut t, 10, &[]).flips, 0);
     }
 
     #[test]
@@ -857,7 +862,7 @@ mod tests {
         let p = rhombus();
         let n = vec![[0.0, 0.0, -1.0]; 4];
         let mut t = vec![[0, 1, 2], [0, 2, 3]];
-        let pass = flip_to_surface_delaunay(&p, &n, &mut t, 10);
+        let pass = flip_to_surface_delaunay(&p, &n, &mut t, 10, &[]);
         assert_eq!((pass.flips, pass.folded), (0, Some(true)));
         assert!(t.iter().all(|&t| against_field(&p, &n, t)));
     }
@@ -869,7 +874,7 @@ mod tests {
         let n = vec![[0.0, 0.0, 1.0]; 5];
         let mut t = vec![[0, 1, 2], [0, 2, 3], [0, 2, 4]];
         let before = t.clone();
-        let pass = flip_to_surface_delaunay(&p, &n, &mut t, 10);
+        let pass = flip_to_surface_delaunay(&p, &n, &mut t, 10, &[]);
         assert_eq!((pass.flips, pass.folded), (0, None));
         assert_eq!(t, before);
     }

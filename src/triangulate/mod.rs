@@ -27,7 +27,9 @@ pub use refine::{Refinement, MAX_REFINE_ROUNDS};
 pub(crate) use relax::relax;
 pub(crate) use stitch::unpinch;
 pub use stitch::Stitched;
-pub(crate) use untangle::{drop_unused, drop_unused_in, keep_main_component, untangle, Before};
+pub(crate) use untangle::{
+    drop_unused, drop_unused_in, keep_main_component, relax_pinned, untangle, Before,
+};
 pub use untangle::{Untangled, UNTANGLE_ROUNDS};
 
 #[cfg(test)]
@@ -111,7 +113,7 @@ pub fn triangulate<T: Scalar>(
     let mut all = triangles.clone();
     if improve {
         let budget = 8 * all.len() + 64;
-        flip::flip_to_surface_delaunay(&pos, &normals, &mut all, budget);
+        flip::flip_to_surface_delaunay(&pos, &normals, &mut all, budget, &[]);
     }
     // Three points on a line in space (curves that ran straight along a degenerate field)
     // make a triangle of no area and no normal, however good it looks in the chart.

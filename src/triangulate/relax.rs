@@ -22,11 +22,14 @@ const SWEEPS: usize = 3;
 pub(super) const DAMPING: f64 = 0.5;
 
 /// Relaxes `mesh`, whose vertices in the working precision are `vertices` (moved in place).
+/// Vertices marked in `pinned` (empty: none) stay where they are, and so do the edges of
+/// the triangles around them.
 pub(crate) fn relax<T: Scalar, F: NormalField<T>>(
     field: &F,
     params: &Resolved,
     mesh: &mut Mesh,
     vertices: &mut Vec<Vec3<T>>,
+    pinned: &[bool],
 ) {
     let n = mesh.vertices.len();
     let mut pos: Vec<Vec3<T>> = std::mem::take(vertices);
@@ -57,11 +60,14 @@ pub(crate) fn relax<T: Scalar, F: NormalField<T>>(
             }
         }
     }
-    // p0 stays where it is (the vertex of curve 0's first point).
+    // p0 stays where it is (the vertex of curve 0's first point), and so do the pinned.
     for (v, pr) in mesh.provenance.iter().enumerate() {
         if pr.curve == 0 && pr.step == 0 {
             fixed[v] = true;
         }
+    }
+    for (f, &p) in fixed.iter_mut().zip(pinned) {
+        *f |= p;
     }
     let mut len = vec![0u32; n];
     for v in 0..n {
@@ -103,7 +109,13 @@ pub(crate) fn relax<T: Scalar, F: NormalField<T>>(
             .unwrap_or([0.0; 3]);
     });
     let budget = 8 * mesh.triangles.len() + 64;
-    flip_to_surface_delaunay(&mesh.vertices, &mesh.normals, &mut mesh.triangles, budget);
+    flip_to_surface_delaunay(
+        &mesh.vertices,
+        &mesh.normals,
+        &mut mesh.triangles,
+        budget,
+        pinned,
+    );
     *vertices = pos;
 }
 

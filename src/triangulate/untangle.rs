@@ -6,6 +6,9 @@
 //! a non-integrable field's sweep). Here the crossings are found exactly, over the whole mesh,
 //! and undone:
 //!
+//! 0. if relaxation made them ([`relax_pinned`]), the mesh goes back to where it was before
+//!    relaxation and is relaxed again with the vertices around the crossing faces pinned (a
+//!    ring wider each time, while that leaves fewer crossings): the surface keeps its faces;
 //! 1. vertices of crossing faces that relaxation moved go back to where they were before it
 //!    (a round of that which leaves no fewer crossings is taken back: the flips after
 //!    relaxation may have joined those vertices differently);
@@ -16,13 +19,19 @@
 //! What was removed is counted in [`Untangled`] and reported; a mesh that still crosses itself
 //! after [`UNTANGLE_ROUNDS`] rounds is an error, never an output.
 
+use super::relax::relax;
 use super::stitch::unpinch;
 use crate::geom::union_find::UnionFind;
 use crate::mesh::Mesh;
+use crate::params::Resolved;
 use crate::scalar::{Scalar, Vec3};
+use crate::NormalField;
 
 /// Rounds of finding crossings and undoing them.
 pub const UNTANGLE_ROUNDS: usize = 16;
+
+/// Times relaxation is run again, with more vertices pinned, when it made faces cross.
+const RELAX_AGAIN: usize = 3;
 
 /// What untangling did.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -34,6 +43,66 @@ pub struct Untangled {
     pub removed: usize,
     /// Crossing face pairs left (0 unless the rounds ran out).
     pub left: usize,
+    /// Vertices pinned where they were before relaxation when it was run again because it
+    /// had made faces cross (0 if it did not).
+    pub pinned: usize,
+}
+
+/// Relaxation made faces cross (`crossings` lists them): the mesh goes back to `before` and
+/// is relaxed again with the crossing faces' vertices and their neighbours pinned, a ring
+/// wider each time, up to [`RELAX_AGAIN`] times while that leaves fewer crossings. The state
+/// with the fewest crossings is kept. Returns how many vertices were pinned in it.
+pub(crate) fn relax_pinned<T: Scalar, F: NormalField<T>>(
+    field: &F,
+    params: &Resolved,
+    mesh: &mut Mesh,
+    vertices: &mut Vec<Vec3<T>>,
+    before: &Before<T>,
+    crossings: impl Fn(&[[f64; 3]], &[[u32; 3]]) -> Vec<(usize, usize)>,
+) -> usize {
+    let n = before.positions.len();
+    if mesh.vertices.len() != n {
+        return 0;
+    }
+    let mut pairs = crossings(&mesh.vertices, &mesh.triangles);
+    let mut pinned = vec![false; n];
+    let mut kept_pins = 0;
+    for _ in 0..RELAX_AGAIN {
+        if pairs.is_empty() {
+            break;
+        }
+        // The crossing faces' corners, then one ring more around everything pinned so far.
+        for &(f, g) in &pairs {
+            for v in mesh.triangles[f].into_iter().chain(mesh.triangles[g]) {
+                pinned[v as usize] = true;
+            }
+        }
+        let ring: Vec<u32> = before
+            .triangles
+            .iter()
+            .filter(|t| t.iter().any(|&v| pinned[v as usize]))
+            .flatten()
+            .copied()
+            .collect();
+        for v in ring {
+            pinned[v as usize] = true;
+        }
+        let last = (
+            std::mem::replace(&mut mesh.vertices, before.positions.clone()),
+            std::mem::replace(&mut mesh.normals, before.normals.clone()),
+            std::mem::replace(&mut mesh.triangles, before.triangles.clone()),
+            std::mem::replace(vertices, before.working.clone()),
+        );
+        relax(field, params, mesh, vertices, &pinned);
+        let now = crossings(&mesh.vertices, &mesh.triangles);
+        if now.len() >= pairs.len() {
+            (mesh.vertices, mesh.normals, mesh.triangles, *vertices) = last;
+            break;
+        }
+        pairs = now;
+        kept_pins = pinned.iter().filter(|&&p| p).count();
+    }
+    kept_pins
 }
 
 /// Finds the crossings of `mesh` with `crossings` and undoes them (see the module docs).
@@ -136,6 +205,7 @@ pub(crate) struct Before<T> {
     pub(crate) positions: Vec<[f64; 3]>,
     pub(crate) normals: Vec<[f64; 3]>,
     pub(crate) working: Vec<Vec3<T>>,
+    pub(crate) triangles: Vec<[u32; 3]>,
 }
 
 /// Keeps only the faces of the component (faces connected through edges) that holds `p0`'s
