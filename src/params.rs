@@ -218,7 +218,9 @@ impl Default for MeshParams {
 ///   floor keeps a sharp tip, such as an elongated ellipsoid's, from shrinking the steps
 ///   everywhere else).
 ///
-/// On a sphere of radius `r` both are `r`: the mesh is the same at every scale.
+/// On a sphere of radius `r` both are `r`: the mesh is the same at every scale. A field that
+/// knows how far its surface reaches ([`NormalField::size_through`], a quadric) raises the
+/// extent to that ([`Scales::reaching`]).
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct Scales {
@@ -245,6 +247,15 @@ impl Scales {
             extent
         };
         Scales { extent, step }
+    }
+
+    /// The scales with the extent raised to `size` when the field knows how far its surface
+    /// reaches ([`NormalField::size_through`]); the step scale stays the local one.
+    pub fn reaching(self, size: Option<f64>) -> Scales {
+        match size {
+            Some(s) if s > self.extent => Scales { extent: s, ..self },
+            _ => self,
+        }
     }
 }
 
@@ -334,7 +345,7 @@ impl MeshParams {
                 normal: v,
             });
         };
-        let scales = Scales::of(self.p0, &shape);
+        let scales = Scales::of(self.p0, &shape).reaching(field.size_through(self.p0));
         let w00 = match self.w00 {
             Some(w) => w,
             None => least_aligned_tangent(shape.normal),

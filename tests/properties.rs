@@ -309,6 +309,9 @@ impl<T: liemesh::scalar::Scalar, F: liemesh::NormalField<T>> liemesh::NormalFiel
     ) -> (liemesh::scalar::Vec3<T>, liemesh::scalar::Vec3<T>) {
         self.0.normal_and_jvp(p, w)
     }
+    fn size_through(&self, p0: [f64; 3]) -> Option<f64> {
+        self.0.size_through(p0)
+    }
 }
 
 /// The `Mpfr<256>` chord solved in `f64` first and refined (with its predicted stops and its

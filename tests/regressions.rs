@@ -359,3 +359,34 @@ fn a_very_narrow_beta_band_runs_until_the_point_budget_and_says_so() {
     assert!(run.validation.is_valid());
     fuzz_checks::check_mesh(&run.mesh).unwrap();
 }
+
+/// Found by trying long ellipsoids as a new user would: from a point on the equator of a
+/// 7:1 or 10:1 ellipsoid the surface looks like a cylinder, so the terminal conditions sized
+/// from `p0` alone cut it into a band (χ = 0). The field knows its quadric's semi-axes
+/// (`NormalField::size_through`) and the defaults reach that far: it closes.
+#[test]
+fn long_ellipsoids_close_from_their_equator() {
+    for (lambda, p0) in [(49.0, [1.0 / 7.0, 0.0, 0.0]), (100.0, [0.0, 0.1, 0.0])] {
+        let invariant = Invariant::from_numbers(&[lambda, lambda, 1.0, 0.0, 0.0, 0.0]).unwrap();
+        let field = LieField::<f64>::new(&invariant);
+        let size = liemesh::NormalField::<f64>::size_through(&field, p0).unwrap();
+        assert!((size - 1.0).abs() < 1e-12, "{lambda}: {size}");
+        let run = liemesh::run(&field, &MeshParams::at(p0)).unwrap();
+        assert!(run.validation.is_valid(), "{lambda}: {}", run.validation);
+        assert!(run.validation.is_closed(), "{lambda}: {}", run.validation);
+        assert_eq!(run.validation.euler_characteristic, 2, "{lambda}");
+    }
+    // A cone (level 0) and a non-symmetric (non-integrable) field know no size.
+    let cone =
+        LieField::<f64>::new(&Invariant::from_numbers(&[1.0, 1.0, -1.0, 0.0, 0.0, 0.0]).unwrap());
+    assert_eq!(
+        liemesh::NormalField::<f64>::size_through(&cone, [1.0, 0.0, 1.0]),
+        None
+    );
+    let twisted =
+        LieField::<f64>::new(&Invariant::from_numbers(&[1.0, 4.0, 9.0, 0.3, 0.5, 0.7]).unwrap());
+    assert_eq!(
+        liemesh::NormalField::<f64>::size_through(&twisted, [1.0, 0.0, 0.0]),
+        None
+    );
+}

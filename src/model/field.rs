@@ -48,6 +48,15 @@ pub trait NormalField<T: Scalar>: Sync {
     fn in_f64(&self) -> Option<&dyn NormalField<f64>> {
         None
     }
+    /// How far from the origin the surface through `p0` reaches, when the field knows it
+    /// (an ellipsoid's longest semi-axis, a hyperboloid's or a cylinder's widest waist):
+    /// the automatic terminal conditions then reach at least that far, where the shape at
+    /// `p0` alone could not tell (the flat side of a long ellipsoid looks like a cylinder).
+    /// The default, `None`, leaves them to the shape at `p0` ([`crate::Scales`]).
+    fn size_through(&self, p0: [f64; 3]) -> Option<f64> {
+        let _ = p0;
+        None
+    }
 }
 
 impl<T: Scalar, F: NormalField<T> + ?Sized> NormalField<T> for &F {
@@ -62,6 +71,9 @@ impl<T: Scalar, F: NormalField<T> + ?Sized> NormalField<T> for &F {
     #[inline(always)]
     fn in_f64(&self) -> Option<&dyn NormalField<f64>> {
         (**self).in_f64()
+    }
+    fn size_through(&self, p0: [f64; 3]) -> Option<f64> {
+        (**self).size_through(p0)
     }
 }
 
@@ -181,6 +193,34 @@ impl<T: Scalar> NormalField<T> for LieField<T> {
 
     fn in_f64(&self) -> Option<&dyn NormalField<f64>> {
         self.in_f64.as_deref().map(|f| f as &dyn NormalField<f64>)
+    }
+
+    /// For a quadric (`B = 0`, `A` symmetric: the level set `pᵀ A p = c` through `p0`), its
+    /// largest semi-axis `√(c / λ)` over the eigenvalues `λ` of `A` of the sign of `c`, the
+    /// directions in which it is bounded. `None` for other fields and for a cone (`c = 0`).
+    fn size_through(&self, p0: [f64; 3]) -> Option<f64> {
+        if self.quadratic {
+            return None;
+        }
+        let a: [[f64; 3]; 3] = std::array::from_fn(|i| self.a[i].to_f64());
+        let scale = a.iter().flatten().fold(0.0_f64, |m, x| m.max(x.abs()));
+        let symmetric = (0..3).all(|i| (0..i).all(|j| (a[i][j] - a[j][i]).abs() <= 1e-12 * scale));
+        if !(symmetric && scale.is_finite() && scale > 0.0) {
+            return None;
+        }
+        // Scaled to entries of order one, so that the eigen solver neither overflows nor
+        // underflows; the semi-axes do not change.
+        let m = nalgebra::Matrix3::from_fn(|i, j| a[i][j] / scale);
+        let p = nalgebra::Vector3::from(p0);
+        let c = p.dot(&(m * p));
+        let eigen = nalgebra::SymmetricEigen::new(m);
+        let size = eigen
+            .eigenvalues
+            .iter()
+            .filter(|&&l| l * c > 0.0 && (l.abs() > 1e-12))
+            .map(|&l| (c / l).sqrt())
+            .fold(None, |m: Option<f64>, x| Some(m.map_or(x, |m| m.max(x))));
+        size.filter(|s| s.is_finite() && *s > 0.0)
     }
 }
 
