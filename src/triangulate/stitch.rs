@@ -88,6 +88,14 @@ const HOVER: f64 = 0.4;
 const NEW_POINT_TURN_COS: f64 = std::f64::consts::FRAC_1_SQRT_2;
 /// Other vertices of a loop keep this fraction of an ear's longest edge away from it.
 const EAR_CLEARANCE: f64 = 0.02;
+/// The proximity tests' budget: this many triangles and points visited per triangle and
+/// boundary edge the chart gave, plus [`VISITS_FLOOR`] (the free vertices' filter in
+/// [`Stitcher::new`] has the same budget). The gallery's surfaces use at most a twentieth of
+/// it; on a surface whose triangles differ in size by orders of magnitude (a hyperboloid
+/// with a 10:1 waist) each test can visit much of the mesh, and the run is then cut short
+/// and says so, instead of running for minutes.
+const VISITS_PER_TRIANGLE: u64 = 400;
+const VISITS_FLOOR: u64 = 1 << 23;
 /// Candidates examined per boundary edge: the nearest ones.
 const MAX_CANDIDATES: usize = 24;
 /// An edge's nearest points are searched for afresh, rather than updated with the points
@@ -430,6 +438,8 @@ pub(crate) fn stitch<T: Scalar, F: NormalField<T>>(
 ) -> (Stitched, usize) {
     let mut s = Stitcher::new(mesh, work, rim, free, growth);
     let mut out = Stitched::default();
+    let visit_budget =
+        VISITS_PER_TRIANGLE * (s.tris.len() + s.boundary_edges()) as u64 + VISITS_FLOOR;
     // The vertices whose boundary edges the next round looks at (all, at first; around the
     // holes that were opened, later).
     let mut opened: Option<HashSet<u32, FastHash>> = None;
@@ -459,7 +469,7 @@ pub(crate) fn stitch<T: Scalar, F: NormalField<T>>(
             if s.memos.get(&(c.a, c.b)).map(|m| m.version) != Some(c.version) {
                 continue;
             }
-            if steps == budget {
+            if steps == budget || s.visits.get() > visit_budget {
                 out.budget_hit = true;
                 s.heap.clear();
                 break;
@@ -688,6 +698,8 @@ struct Stitcher<'a, 'f, T, F> {
     epoch: Vec<u32>,
     /// Which vertices are free samples (see [`Self::is_free`]).
     free: Vec<bool>,
+    /// Triangles and points the proximity tests visited (see [`VISITS_PER_STEP`]).
+    visits: std::cell::Cell<u64>,
 }
 
 impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
@@ -738,14 +750,23 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
         // would only make slivers): where fronts met and the chart's triangles were dropped,
         // the front then advances through the samples instead of placing points of its own.
         let mut is_free = vec![false; n];
+        // (Taking free vertices in is optional: where the tests would visit more than the
+        // budget allows, the rest are left out.)
+        let mut visits = 0u64;
+        let free_budget = VISITS_PER_TRIANGLE * tris.len() as u64 + VISITS_FLOOR;
         for &(v, h) in free {
+            if visits > free_budget {
+                break;
+            }
             let p = pos[v as usize];
             let r = HOVER * h;
             let mut near = false;
             faces.near(&[p.map(|x| x - r), p.map(|x| x + r), p], |f| {
+                visits += 1;
                 near = near || point_triangle_distance(p, corners(&pos, tris[f as usize])) < r;
             });
             points.near(p, r, |w| {
+                visits += 1;
                 near = near || is_free[w as usize] && dist(pos[w as usize], p) < r;
             });
             if !near && h > 0.0 {
@@ -773,6 +794,7 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
             memos: HashMap::default(),
             heap: BinaryHeap::new(),
             wedge_memo: std::cell::Cell::new(false),
+            visits: std::cell::Cell::new(0),
             wedge_angles: std::cell::RefCell::new(HashMap::default()),
             epoch: Vec::new(),
             free: is_free,
@@ -833,6 +855,7 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
             .iter()
             .filter(|t| **t != DEAD)
             .count();
+        let visits = self.visits.get();
         let Stitcher { work, growth, .. } = self;
         *work = snapshot.work;
         mesh.vertices = snapshot.pos;
@@ -842,6 +865,7 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
         let mut s = Stitcher::new(mesh, work, rim, free, growth);
         // (The chart's triangles come first and keep their order.)
         s.initial = initial;
+        s.visits.set(visits);
         (s, snapshot.out)
     }
 
@@ -1185,7 +1209,9 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
             let reach = HOVER * h;
             let box_ = [probe.map(|x| x - reach), probe.map(|x| x + reach), probe];
             let mut near = false;
+            let mut visits = 0;
             self.faces.near(&box_, |f| {
+                visits += 1;
                 let t = self.tris[f as usize];
                 near = near
                     || (t != DEAD
@@ -1193,6 +1219,7 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
                         && !t.contains(&b)
                         && point_triangle_distance(probe, corners(&self.pos, t)) < reach);
             });
+            self.visits.set(self.visits.get() + visits);
             if near {
                 return None;
             }
@@ -1434,7 +1461,9 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
         let c = corners(&self.pos, t);
         let (lo, hi) = bounds(&c);
         let mut hit = false;
+        let mut visits = 0;
         self.faces.near(&c, |f| {
+            visits += 1;
             let g = self.tris[f as usize];
             if hit || g == DEAD {
                 return;
@@ -1448,6 +1477,7 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
             }
             hit = faces_intersect(&self.pos, t, g);
         });
+        self.visits.set(self.visits.get() + visits);
         !hit
     }
 
@@ -1465,7 +1495,9 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
             .fold(0.0, f64::max)
             + clearance;
         let mut crowded = false;
+        let mut visits = 0;
         self.points.near(centre, radius, |w| {
+            visits += 1;
             let p = self.pos[w as usize];
             crowded = crowded
                 || (!t.contains(&w)
@@ -1476,6 +1508,7 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
                             && corners_t.iter().all(|&c| dist(c, p) > 2.0 * clearance))
                     && point_triangle_distance(p, corners_t) < clearance);
         });
+        self.visits.set(self.visits.get() + visits);
         !crowded
     }
 
