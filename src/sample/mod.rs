@@ -193,6 +193,12 @@ const MAX_INSERT_TURN: f64 = 2.0;
 /// steps).
 const MAX_INSERT_SPAN: f64 = 4.0;
 
+/// A curve is inserted only where its neighbours are at least this fraction of their gap in
+/// space apart in the chart (`s` × their angle apart). Measured: at 1% or 0.1%, tilted tori
+/// (whose curves come round the tube close in θ) were left open in 5–9 of 24 cases; at
+/// 0.01%, none, and the pile-up of a folded sweep is cut from 100,876 curves to 9,898.
+const MIN_CHART_SPREAD: f64 = 1e-4;
+
 /// A step clamped at `dt_min` whose predicted turn exceeds this many `β_max` ends its curve
 /// as singular.
 const SINGULAR_TURN: f64 = 2.0;
@@ -744,13 +750,20 @@ impl<T: Scalar, F: NormalField<T>> Sampler<'_, T, F> {
         {
             return;
         }
+        let s = 0.5 * (self.live[c as usize].s + s_target);
+        // Two curves a gap apart in space but with almost the same θ: the chart is singular
+        // there (a fold of a swept sheet), and a curve between them would be as close to
+        // both in the chart. Bisecting on would not separate them; it would only pile up
+        // curves (one twisted field laid a million points at one θ so).
+        if s * span < MIN_CHART_SPREAD * d.norm().to_f64() {
+            return;
+        }
         let half = d.norm() * T::from_f64(0.5);
         let start = match trace::step_fixed(self.field, &self.cfg, &live_c.p, &d, &half) {
             Ok(p) => p,
             Err(_) => return,
         };
         let start_f = start.to_f64();
-        let s = 0.5 * (self.live[c as usize].s + s_target);
         // The terminal conditions hold for inserted points as for stepped ones.
         let bb = self.params.bounding_box;
         if s > self.params.max_radius || start_f.iter().any(|x| x.abs() > bb) {
