@@ -38,6 +38,20 @@ pub enum MeshError {
         /// The field value there.
         normal: [f64; 3],
     },
+    /// The surface at `p0` is too small or too large for `f64` geometry.
+    #[error(
+        "the surface at p0 has size {size:e} (its radius of curvature there, or p0's distance \
+         from the origin); liemesh meshes surfaces of size {min:e} to {max:e}, where squared \
+         lengths and areas stay normal f64 numbers: scale the field's coordinates into that range"
+    )]
+    SurfaceScale {
+        /// The surface's size at `p0` ([`crate::Scales`]).
+        size: f64,
+        /// The smallest size meshed.
+        min: f64,
+        /// The largest size meshed.
+        max: f64,
+    },
     /// `β_min ≥ β_max`, or the band is not inside (0°, 90°).
     #[error(
         "the normal-angle band [β_min, β_max] = [{min_deg}°, {max_deg}°] is invalid; \

@@ -308,6 +308,11 @@ impl std::ops::Deref for Resolved {
     }
 }
 
+/// The smallest surface meshed ([`MeshError::SurfaceScale`]).
+pub(crate) const MIN_SURFACE_SIZE: f64 = 1e-60;
+/// The largest surface meshed ([`MeshError::SurfaceScale`]).
+pub(crate) const MAX_SURFACE_SIZE: f64 = 1e60;
+
 /// Factors of the automatic lengths: Δt, dt_min, dt_max (of the step scale), max_radius and
 /// bounding_box (of the extent scale).
 const AUTO_DT: f64 = 0.1;
@@ -346,6 +351,17 @@ impl MeshParams {
             });
         };
         let scales = Scales::of(self.p0, &shape).reaching(field.size_through(self.p0));
+        // Beyond these sizes products of squared lengths leave f64's normal range (1e-80
+        // and 1e80 were measured to fail in the chart and the validation).
+        for size in [scales.extent, scales.step] {
+            if !(MIN_SURFACE_SIZE..=MAX_SURFACE_SIZE).contains(&size) {
+                return Err(MeshError::SurfaceScale {
+                    size,
+                    min: MIN_SURFACE_SIZE,
+                    max: MAX_SURFACE_SIZE,
+                });
+            }
+        }
         let w00 = match self.w00 {
             Some(w) => w,
             None => least_aligned_tangent(shape.normal),
@@ -378,8 +394,17 @@ impl MeshParams {
         Ok(resolved)
     }
 
-    /// Checks every parameter that does not depend on the surface.
-    fn check(&self) -> Result<(), MeshError> {
+    /// Checks every parameter that does not depend on the surface: numbers finite, the β band
+    /// inside (0°, 90°), lengths and factors in range, budgets non-zero. [`Self::resolve`]
+    /// (and so every run) does this first; call it to catch bad input before a field exists.
+    ///
+    /// ```
+    /// use liemesh::MeshParams;
+    /// let mut params = MeshParams::default();
+    /// params.p0 = [f64::NAN, 0.0, 0.0];
+    /// assert!(params.check().unwrap_err().to_string().contains("p0.x"));
+    /// ```
+    pub fn check(&self) -> Result<(), MeshError> {
         let finite = |name: &'static str, value: f64| {
             if value.is_finite() {
                 Ok(())

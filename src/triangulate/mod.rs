@@ -469,11 +469,20 @@ fn wedge_span(a: [f64; 2], b: [f64; 2]) -> f64 {
 /// Constrained Delaunay triangulation of the chart points, keeping the triangles inside the
 /// front polygon.
 fn chart_triangles(chart: &[[f64; 2]], front: &[u32]) -> Result<Vec<[u32; 3]>, MeshError> {
+    // spade takes coordinates between about 1e-43 and 1e60 in magnitude: a chart far outside
+    // (a surface of size 1e-50 or 1e100) is scaled by a power of two, which changes no
+    // predicate's sign; charts of ordinary size are handed over as they are.
+    let largest = chart.iter().flatten().fold(0.0_f64, |m, x| m.max(x.abs()));
+    let unit = if largest > 0.0 && !(2f64.powi(-60)..=2f64.powi(60)).contains(&largest) {
+        2f64.powi(-largest.log2().round() as i32)
+    } else {
+        1.0
+    };
     let vertices: Vec<ChartVertex> = chart
         .iter()
         .enumerate()
         .map(|(i, c)| ChartVertex {
-            position: Point2::new(c[0], c[1]),
+            position: Point2::new(c[0] * unit, c[1] * unit),
             index: i as u32,
         })
         .collect();
@@ -531,7 +540,10 @@ fn chart_triangles(chart: &[[f64; 2]], front: &[u32]) -> Result<Vec<[u32; 3]>, M
         .filter_map(|face| {
             let [a, b, c] = face.vertices();
             let (pa, pb, pc) = (a.position(), b.position(), c.position());
-            let centroid = [(pa.x + pb.x + pc.x) / 3.0, (pa.y + pb.y + pc.y) / 3.0];
+            let centroid = [
+                (pa.x + pb.x + pc.x) / 3.0 / unit,
+                (pa.y + pb.y + pc.y) / 3.0 / unit,
+            ];
             (inside(centroid) && !rounding_sliver(pa, pb, pc))
                 .then(|| [a.data().index, b.data().index, c.data().index])
         })
