@@ -110,6 +110,32 @@ fn bad_input_exits_2_with_a_one_line_message() {
         "{err}"
     );
     assert_eq!(err.trim().lines().count(), 1, "{err}");
+
+    // A NaN, from a flag or from the file, is named (it once reached a JSON conversion as
+    // null: "invalid type: null").
+    let o = liemesh()
+        .args(["mesh", "--preset", "fig3", "--p0", "nan,0,0", "-o"])
+        .arg(dir.join("x.ply"))
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(2));
+    let err = String::from_utf8(o.stderr).unwrap();
+    assert!(err.contains("--p0") && err.contains("finite"), "{err}");
+    std::fs::write(
+        &file,
+        "invariant = [1, 1, 1, 0, 0, 0]\n[mesh]\np0 = [nan, 0, 0]\n",
+    )
+    .unwrap();
+    let o = liemesh()
+        .args(["mesh", "--invariant"])
+        .arg(&file)
+        .arg("-o")
+        .arg(dir.join("x.ply"))
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(2));
+    let err = String::from_utf8(o.stderr).unwrap();
+    assert!(err.contains("p0.x") && err.contains("NaN"), "{err}");
 }
 
 #[test]

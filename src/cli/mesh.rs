@@ -129,47 +129,47 @@ pub struct Overrides {
     #[serde(skip_serializing_if = "Option::is_none")]
     pub w00: Option<[f64; 3]>,
     /// Initial step Δt (default: from the surface's curvature at p0).
-    #[arg(long, allow_hyphen_values = true)]
+    #[arg(long, allow_hyphen_values = true, value_parser = parse_finite)]
     #[serde(skip_serializing_if = "Option::is_none")]
     pub dt: Option<f64>,
     /// Smallest step.
-    #[arg(long, allow_hyphen_values = true)]
+    #[arg(long, allow_hyphen_values = true, value_parser = parse_finite)]
     #[serde(skip_serializing_if = "Option::is_none")]
     pub dt_min: Option<f64>,
     /// Largest step.
-    #[arg(long, allow_hyphen_values = true)]
+    #[arg(long, allow_hyphen_values = true, value_parser = parse_finite)]
     #[serde(skip_serializing_if = "Option::is_none")]
     pub dt_max: Option<f64>,
     /// β_min in degrees.
-    #[arg(long, allow_hyphen_values = true, value_name = "DEG")]
+    #[arg(long, allow_hyphen_values = true, value_parser = parse_finite, value_name = "DEG")]
     #[serde(rename = "beta_min_deg", skip_serializing_if = "Option::is_none")]
     pub beta_min: Option<f64>,
     /// β_max in degrees.
-    #[arg(long, allow_hyphen_values = true, value_name = "DEG")]
+    #[arg(long, allow_hyphen_values = true, value_parser = parse_finite, value_name = "DEG")]
     #[serde(rename = "beta_max_deg", skip_serializing_if = "Option::is_none")]
     pub beta_max: Option<f64>,
     /// Growth factor δ > 1.
-    #[arg(long, allow_hyphen_values = true)]
+    #[arg(long, allow_hyphen_values = true, value_parser = parse_finite)]
     #[serde(skip_serializing_if = "Option::is_none")]
     pub grow: Option<f64>,
     /// Shrink factor δ' in (0, 1).
-    #[arg(long, allow_hyphen_values = true)]
+    #[arg(long, allow_hyphen_values = true, value_parser = parse_finite)]
     #[serde(skip_serializing_if = "Option::is_none")]
     pub shrink: Option<f64>,
     /// Insert a curve when neighbours are this many steps apart.
-    #[arg(long, allow_hyphen_values = true)]
+    #[arg(long, allow_hyphen_values = true, value_parser = parse_finite)]
     #[serde(skip_serializing_if = "Option::is_none")]
     pub gap: Option<f64>,
     /// End a curve closer than this many steps to a neighbour.
-    #[arg(long, allow_hyphen_values = true)]
+    #[arg(long, allow_hyphen_values = true, value_parser = parse_finite)]
     #[serde(skip_serializing_if = "Option::is_none")]
     pub merge: Option<f64>,
     /// Largest geodesic radius (default: from the surface's size at p0).
-    #[arg(long, allow_hyphen_values = true)]
+    #[arg(long, allow_hyphen_values = true, value_parser = parse_finite)]
     #[serde(skip_serializing_if = "Option::is_none")]
     pub max_radius: Option<f64>,
     /// Half-size of the bounding box around the origin (default: from the surface's size).
-    #[arg(long, allow_hyphen_values = true)]
+    #[arg(long, allow_hyphen_values = true, value_parser = parse_finite)]
     #[serde(skip_serializing_if = "Option::is_none")]
     pub bounding_box: Option<f64>,
     /// Do not stop curves where fronts meet nor stitch them (`close = false`).
@@ -195,7 +195,7 @@ pub struct Overrides {
     pub max_retries: Option<usize>,
     /// Refine the mesh until no face's normal deviates from the field normal at its
     /// centroid by more than this many degrees (splits the longest edges of the worst faces)
-    #[arg(long, allow_hyphen_values = true, value_name = "DEG")]
+    #[arg(long, allow_hyphen_values = true, value_parser = parse_finite, value_name = "DEG")]
     #[serde(
         rename = "max_normal_error_deg",
         skip_serializing_if = "Option::is_none"
@@ -206,6 +206,8 @@ pub struct Overrides {
 impl Overrides {
     /// `params` with the flags given applied on top.
     pub fn apply(&self, params: MeshParams) -> Result<MeshParams, CliError> {
+        // (A non-finite number would reach the JSON below as null: it is named here instead.)
+        params.check().map_err(|e| CliError::Usage(e.to_string()))?;
         let bad = |e: serde_json::Error| CliError::Usage(format!("parameters: {e}"));
         let mut value = serde_json::to_value(&params).map_err(bad)?;
         let flags = serde_json::to_value(self).map_err(bad)?;
@@ -234,11 +236,19 @@ pub(super) fn parse_vec3(s: &str) -> Result<[f64; 3], String> {
     }
     let mut v = [0.0; 3];
     for (i, p) in parts.iter().enumerate() {
-        v[i] = p
-            .parse::<f64>()
-            .map_err(|_| format!("\"{p}\" is not a number (in \"{s}\")"))?;
+        v[i] = parse_finite(p).map_err(|e| format!("{e} (in \"{s}\")"))?;
     }
     Ok(v)
+}
+
+/// A finite number (NaN and infinities are refused here, with the flag's name, rather than
+/// deep in the run).
+pub(super) fn parse_finite(s: &str) -> Result<f64, String> {
+    match s.parse::<f64>() {
+        Ok(x) if x.is_finite() => Ok(x),
+        Ok(_) => Err(format!("\"{s}\" is not a finite number")),
+        Err(_) => Err(format!("\"{s}\" is not a number")),
+    }
 }
 
 impl MeshArgs {
