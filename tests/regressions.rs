@@ -390,3 +390,52 @@ fn long_ellipsoids_close_from_their_equator() {
         None
     );
 }
+
+/// Found by trying the paper's literal eq. 2 with angles from `p0 = (1, 0, 0)`: where the
+/// swept sheet folds, neighbouring curves with almost the same θ lie a gap apart in space,
+/// and insertion bisected θ between them down to 1e-9 over and over: 100,876 curves and
+/// 1.1 million samples for a mesh of 4,024 vertices, 290 s. Insertion now needs the two
+/// curves apart in the chart too.
+#[test]
+fn a_folded_sweep_does_not_pile_up_inserted_curves() {
+    let invariant = Invariant::from_numbers(&[1.0, 4.0, 16.0, 0.3, 0.5, 0.7]).unwrap();
+    let field = LieField::<f64>::new(&invariant);
+    let run = liemesh::run(&field, &MeshParams::at([1.0, 0.0, 0.0])).unwrap();
+    // (Measured: 9,898 curves and 133,039 samples, many of them where curves run into the
+    // field's singular point at the origin.)
+    let (curves, points) = (run.samples.curves.len(), run.samples.points.len());
+    assert!(
+        curves < 20_000 && points < 300_000,
+        "{curves} curves, {points} samples"
+    );
+    assert!(run.validation.is_valid(), "{}", run.validation);
+    assert!(
+        run.mesh.triangles.len() > 1000,
+        "{}",
+        run.mesh.triangles.len()
+    );
+}
+
+/// Found by trying a sphere at extreme scales: at 1e-50 spade refused the chart's points
+/// (too small) and at 1e-80 or 1e80 every triangle was lost to underflowing products, with
+/// a message about folds. Charts are now scaled for spade, and surfaces beyond the sizes
+/// f64 geometry holds get a typed error that says so.
+#[test]
+fn spheres_mesh_alike_over_the_supported_scales_and_beyond_them_say_why() {
+    let field = sphere();
+    let counts: Vec<usize> = [1.01e-60, 1e-50, 1.0, 1e50, 0.99e60]
+        .iter()
+        .map(|&r| {
+            let run = liemesh::run(&field, &MeshParams::at([r, 0.0, 0.0])).unwrap();
+            assert!(run.validation.is_closed(), "{r}: {}", run.validation);
+            run.mesh.triangles.len()
+        })
+        .collect();
+    assert!(counts.iter().all(|&n| n == counts[0]), "{counts:?}");
+    for r in [1e-80, 1e100] {
+        match liemesh::run(&field, &MeshParams::at([r, 0.0, 0.0])) {
+            Err(MeshError::SurfaceScale { size, .. }) => assert_eq!(size, r),
+            other => panic!("{r}: {:?}", other.map(|r| r.mesh.triangles.len())),
+        }
+    }
+}
