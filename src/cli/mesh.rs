@@ -206,8 +206,6 @@ pub struct Overrides {
 impl Overrides {
     /// `params` with the flags given applied on top.
     pub fn apply(&self, params: MeshParams) -> Result<MeshParams, CliError> {
-        // (A non-finite number would reach the JSON below as null: it is named here instead.)
-        params.check().map_err(|e| CliError::Usage(e.to_string()))?;
         let bad = |e: serde_json::Error| CliError::Usage(format!("parameters: {e}"));
         let mut value = serde_json::to_value(&params).map_err(bad)?;
         let flags = serde_json::to_value(self).map_err(bad)?;
@@ -223,7 +221,13 @@ impl Overrides {
         if self.no_close {
             target.insert("close".into(), false.into());
         }
-        serde_json::from_value(value).map_err(bad)
+        // A non-finite number in the file reaches the JSON as null and fails here: the
+        // parameters' own check names it. (The flags are finite by their parser, and the
+        // combination is checked in full when the run resolves it.)
+        serde_json::from_value(value).map_err(|e| match params.check() {
+            Err(named) => CliError::Usage(named.to_string()),
+            Ok(()) => bad(e),
+        })
     }
 }
 

@@ -745,8 +745,9 @@ impl<T: Scalar, F: NormalField<T>> Sampler<'_, T, F> {
             .clamp(-1.0, 1.0)
             .acos();
         let step = self.out.steps[last_k].dt.max(len);
+        let gap = d.norm().to_f64();
         if turn > MAX_INSERT_TURN * self.params.gap * self.params.beta_max.radians()
-            || d.norm().to_f64() > MAX_INSERT_SPAN * self.params.gap * step
+            || gap > MAX_INSERT_SPAN * self.params.gap * step
         {
             return;
         }
@@ -755,7 +756,7 @@ impl<T: Scalar, F: NormalField<T>> Sampler<'_, T, F> {
         // there (a fold of a swept sheet), and a curve between them would be as close to
         // both in the chart. Bisecting on would not separate them; it would only pile up
         // curves (one twisted field laid a million points at one θ so).
-        if s * span < MIN_CHART_SPREAD * d.norm().to_f64() {
+        if s * span < MIN_CHART_SPREAD * gap {
             return;
         }
         let half = d.norm() * T::from_f64(0.5);
