@@ -206,6 +206,50 @@ fn each_error_is_printed_once() {
 }
 
 #[test]
+fn a_failed_run_still_writes_its_report_saying_why() {
+    let dir = scratch("failed");
+    let file = dir.join("singular.toml");
+    std::fs::write(
+        &file,
+        "invariant = [1, 1, 1, 0, 0, 0]\n[mesh]\np0 = [0, 0, 0]\n",
+    )
+    .unwrap();
+    let (mesh, report) = (dir.join("x.ply"), dir.join("r.json"));
+    let o = liemesh()
+        .args(["mesh", "--invariant"])
+        .arg(&file)
+        .arg("-o")
+        .arg(&mesh)
+        .arg("--report")
+        .arg(&report)
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(err.contains("singular point"), "{err}");
+    assert!(!mesh.exists(), "no mesh is written for a failed run");
+    let r: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&report).unwrap()).unwrap();
+    assert!(
+        r["error"].as_str().unwrap().contains("singular point"),
+        "{r}"
+    );
+    assert_eq!(r["parameters"]["p0"], serde_json::json!([0.0, 0.0, 0.0]));
+    assert_eq!(r["invariant"].as_array().unwrap().len(), 6);
+    assert!(r.get("triangles").is_none(), "{r}");
+
+    // --json prints the same report on standard output.
+    let o = liemesh()
+        .args(["mesh", "--json", "--invariant"])
+        .arg(&file)
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(2));
+    let printed: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(printed, r);
+}
+
+#[test]
 fn an_invariant_file_meshes_an_ellipsoid_in_every_format() {
     let dir = scratch("ellipsoid");
     let file = dir.join("ellipsoid.toml");

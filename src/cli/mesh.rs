@@ -4,7 +4,7 @@ use super::progress::{grouped, with_progress, Status};
 use super::CliError;
 use clap::Args;
 use liemesh::io::invariant_file::InvariantFile;
-use liemesh::io::report::{Report, VertexDerivatives};
+use liemesh::io::report::{FailureReport, Report, VertexDerivatives};
 use liemesh::io::{self, WriteOptions};
 use liemesh::model::{AngleReading, Invariant, LieField};
 use liemesh::preset::Preset;
@@ -38,7 +38,7 @@ pub struct MeshArgs {
     /// Write PLY as ASCII.
     #[arg(long)]
     pub ascii: bool,
-    /// Write a JSON report of the run.
+    /// Write a JSON report of the run (of a run that failed: what was asked and why it failed).
     #[arg(long, value_name = "FILE.json")]
     pub report: Option<PathBuf>,
     /// Scalar type of the computation.
@@ -53,7 +53,8 @@ pub struct MeshArgs {
     /// Print nothing on success.
     #[arg(short, long)]
     pub quiet: bool,
-    /// Print the report as JSON on standard output instead of the summary.
+    /// Print the report as JSON on standard output instead of the summary (also when the run
+    /// fails).
     #[arg(long)]
     pub json: bool,
     /// Parameter overrides (they win over the preset and the file).
@@ -419,7 +420,30 @@ pub(super) fn run(args: &MeshArgs) -> Result<ExitCode, CliError> {
     let scalar = ScalarKind::from(args.scalar);
     let measure = args.report.is_some() || args.json;
     let (outcome, derivatives) = with_progress(args.quiet, |status| {
-        let outcome = mesh_invariant(&invariant, &params, scalar, measure, status)?;
+        let outcome = match mesh_invariant(&invariant, &params, scalar, measure, status) {
+            Err(CliError::Mesh(e)) => {
+                // The report says why there is no mesh (`--report`, `--json`); the error
+                // still goes to the terminal and the exit code.
+                let failure = FailureReport::new(
+                    preset.map(|p| p.name().to_string()),
+                    &invariant,
+                    scalar,
+                    &params,
+                    &e,
+                );
+                if let Some(path) = &args.report {
+                    write_json(path, &failure)?;
+                }
+                if args.json {
+                    println!(
+                        "{}",
+                        serde_json::to_string_pretty(&failure).expect("reports serialise")
+                    );
+                }
+                return Err(CliError::Mesh(e));
+            }
+            other => other?,
+        };
         let derivatives = derivatives(args, &invariant, &params, &outcome.mesh, status)?;
         if let Some(out) = &args.output {
             status.step(format!("writing {}", out.display()));

@@ -6,6 +6,7 @@ use crate::params::MeshParams;
 use crate::quality::Topology;
 use crate::scalar::ScalarKind;
 use crate::triangulate::Mesh;
+use crate::MeshError;
 
 /// What a meshing run reports: counts, topology, time, and everything needed to rerun it.
 #[derive(Clone, Debug, PartialEq)]
@@ -76,6 +77,57 @@ pub struct Report {
         serde(default, skip_serializing_if = "Vec::is_empty")
     )]
     pub derivatives: Vec<VertexDerivatives>,
+}
+
+/// What a meshing run that failed reports: what was asked, and why it failed (what the
+/// command line writes as JSON in place of a [`Report`] when there is no mesh to report on).
+/// A reader tells the two apart by the `error` field, which only this one has.
+#[derive(Clone, Debug, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+pub struct FailureReport {
+    /// Preset name, if the run used one.
+    pub preset: Option<String>,
+    /// The invariant's numbers (6 or 18).
+    pub invariant: Vec<f64>,
+    /// Whether `H` lies in sp(6).
+    pub hamiltonian_in_sp6: bool,
+    /// Scalar type the run worked in.
+    pub scalar: ScalarKind,
+    /// The parameters given.
+    pub parameters: MeshParams,
+    /// Why the run failed, in the words of its [`MeshError`].
+    pub error: String,
+    /// The validation the mesh failed, when it came out invalid ([`MeshError::Invalid`]).
+    #[cfg_attr(
+        feature = "serde",
+        serde(default, skip_serializing_if = "Option::is_none")
+    )]
+    pub validation: Option<crate::mesh::Validation>,
+}
+
+impl FailureReport {
+    /// The report of meshing `invariant` with `parameters` in `scalar`, which failed with
+    /// `error`.
+    pub fn new(
+        preset: Option<String>,
+        invariant: &Invariant,
+        scalar: ScalarKind,
+        parameters: &MeshParams,
+        error: &MeshError,
+    ) -> FailureReport {
+        FailureReport {
+            preset,
+            invariant: invariant.numbers(),
+            hamiltonian_in_sp6: invariant.is_in_sp6(),
+            scalar,
+            parameters: parameters.clone(),
+            error: error.to_string(),
+            validation: match error {
+                MeshError::Invalid(v) => Some((**v).clone()),
+                _ => None,
+            },
+        }
+    }
 }
 
 /// `d(vertex)/d(number)` for every vertex, with respect to one invariant number
