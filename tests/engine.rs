@@ -252,43 +252,55 @@ fn dual_numbers_carry_vertex_sensitivities() {
 
 #[cfg(feature = "mpfr")]
 #[test]
-#[ignore = "open since the stitching round: see docs/status.md"]
-fn fig3_in_f64_agrees_with_mpfr256_within_1e_minus_9() {
+fn presets_in_f64_agree_with_mpfr256_within_1e_minus_9() {
     use liemesh::scalar::Mpfr;
-    let r64 = preset_run::<f64>(Preset::Fig3);
-    let rmp = preset_run::<Mpfr<256>>(Preset::Fig3);
-    // Same discrete decisions: the same curves and points (arc lengths differ in the last
-    // bits), and the same triangles up to where each triangle's listing starts.
-    let ids = |r: &[liemesh::Provenance]| r.iter().map(|p| (p.curve, p.step)).collect::<Vec<_>>();
-    assert_eq!(ids(&r64.samples.provenance), ids(&rmp.samples.provenance));
-    let canonical = |t: &[[u32; 3]]| {
-        let mut v: Vec<[u32; 3]> = t
-            .iter()
-            .map(|t| {
-                let k = (0..3).min_by_key(|&k| t[k]).unwrap();
-                [t[k], t[(k + 1) % 3], t[(k + 2) % 3]]
-            })
-            .collect();
-        v.sort_unstable();
-        v
-    };
-    assert_eq!(
-        canonical(&r64.mesh.triangles),
-        canonical(&rmp.mesh.triangles)
-    );
-    let max_diff = |a: &[liemesh::scalar::Vec3<f64>], b: &[liemesh::scalar::Vec3<Mpfr<256>>]| {
-        a.iter()
-            .zip(b)
-            .flat_map(|(a, b)| (0..3).map(move |k| (a[k] - b[k].to_f64()).abs()))
-            .fold(0.0_f64, f64::max)
-    };
-    let samples = max_diff(&r64.samples.points, &rmp.samples.points);
-    let vertices = max_diff(&r64.vertices, &rmp.vertices);
-    assert!(samples <= 1e-9, "samples, f64 vs Mpfr<256>: {samples:e}");
-    assert!(
-        vertices <= 1e-9,
-        "mesh vertices, f64 vs Mpfr<256>: {vertices:e}"
-    );
+    for p in Preset::ALL {
+        let r64 = preset_run::<f64>(p);
+        let rmp = preset_run::<Mpfr<256>>(p);
+        // Same discrete decisions: the same curves and points (arc lengths differ in the last
+        // bits), and the same triangles up to where each triangle's listing starts, the
+        // stitched ones included (fig2's and fig3's far caps tie on symmetric triangles).
+        let ids =
+            |r: &[liemesh::Provenance]| r.iter().map(|p| (p.curve, p.step)).collect::<Vec<_>>();
+        assert_eq!(
+            ids(&r64.samples.provenance),
+            ids(&rmp.samples.provenance),
+            "{p}"
+        );
+        let canonical = |t: &[[u32; 3]]| {
+            let mut v: Vec<[u32; 3]> = t
+                .iter()
+                .map(|t| {
+                    let k = (0..3).min_by_key(|&k| t[k]).unwrap();
+                    [t[k], t[(k + 1) % 3], t[(k + 2) % 3]]
+                })
+                .collect();
+            v.sort_unstable();
+            v
+        };
+        assert_eq!(
+            canonical(&r64.mesh.triangles),
+            canonical(&rmp.mesh.triangles),
+            "{p}"
+        );
+        let max_diff = |a: &[liemesh::scalar::Vec3<f64>],
+                        b: &[liemesh::scalar::Vec3<Mpfr<256>>]| {
+            a.iter()
+                .zip(b)
+                .flat_map(|(a, b)| (0..3).map(move |k| (a[k] - b[k].to_f64()).abs()))
+                .fold(0.0_f64, f64::max)
+        };
+        let samples = max_diff(&r64.samples.points, &rmp.samples.points);
+        let vertices = max_diff(&r64.vertices, &rmp.vertices);
+        assert!(
+            samples <= 1e-9,
+            "{p}: samples, f64 vs Mpfr<256>: {samples:e}"
+        );
+        assert!(
+            vertices <= 1e-9,
+            "{p}: mesh vertices, f64 vs Mpfr<256>: {vertices:e}"
+        );
+    }
 }
 
 #[test]

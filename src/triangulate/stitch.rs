@@ -373,6 +373,16 @@ const REDO_HOLE: usize = 48;
 /// of a score after its glue.
 const MAX_MIN_ANGLE: f64 = 3.5;
 
+/// A triangle's smallest angle as its score counts it: rounded to a multiple of 2⁻³² rad, so
+/// that triangles whose angles differ only by rounding (symmetric ones, such as the far cap
+/// of a sphere traced from its pole, where four curve ends lie on one circle) tie, and the
+/// tie goes by vertex ids. The choice is then the same in every working precision (`f64`
+/// and `Mpfr<256>` samples differ in their last bits), not the rounding's.
+fn quantized(angle: f64) -> f64 {
+    const QUANTUM: f64 = 1.0 / (1u64 << 32) as f64;
+    (angle / QUANTUM).round() * QUANTUM
+}
+
 /// The candidate vertex of an edge that is not there yet: the edge's new point.
 const NEW: u32 = u32::MAX;
 
@@ -972,7 +982,9 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
                 continue;
             }
             if let Some(score) = self.refresh_score(a, b, x, reach, &mut memo.scores) {
-                if best.is_none_or(|(s, _)| score > s) {
+                // Equal scores go to the smaller vertex id, not to the nearer candidate: the
+                // distances of symmetric candidates differ only by rounding.
+                if best.is_none_or(|(s, bx)| score > s || (score == s && x < bx)) {
                     best = Some((score, x));
                 }
             }
@@ -1351,7 +1363,7 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
         {
             return None;
         }
-        Some(4.0 * f64::from(self.glue(a, b, x)) + min_angle)
+        Some(4.0 * f64::from(self.glue(a, b, x)) + quantized(min_angle))
     }
 
     /// How many of triangle `(b, a, x)`'s other edges close a boundary edge (its score's
