@@ -280,6 +280,16 @@ fn insertion_sort(v: &mut [u64]) {
     }
 }
 
+/// Faces from which the topology and the geometry run side by side, and the pair tests by
+/// chunks of cells, on rayon's pool (it was 16,384). Validation costs 340–420 ns a face on
+/// one thread. Measured on two cores: in a loop of `Mesh::validate` (a warm pool) fig3's
+/// 1,980 faces went 338 → 250 ns a face and the 10⁴ sphere's 373 → 278; inside whole runs
+/// (`MeshRun::timings`, best of 5, two runs of each build alternated) the 10⁴ sphere's
+/// validation stage went 441–446 → 366–392 ns a triangle and the 10⁴ ellipsoid's 497–508 →
+/// 311–336, while the presets gained nothing (waking the pool costs what it saves), and at
+/// 512 faces fig5 and fig6 (under 900 faces) lost 20%.
+const PARALLEL_FACES: usize = 1024;
+
 /// The validation of the mesh with vertex positions `p` and faces `tris`.
 ///
 /// The checks read the mesh in a local layout: vertices renumbered in the Morton order of
@@ -381,7 +391,7 @@ pub(crate) fn validate_listing_crossings(
             geometry(Checked, &q, &faces, &geo)
         }
     };
-    let (degenerate, crossings) = if faces.len() >= par::MIN_CHEAP {
+    let (degenerate, crossings) = if faces.len() >= PARALLEL_FACES {
         par::join(topology_part, geometry_part).1
     } else {
         topology_part();
@@ -531,7 +541,7 @@ fn geometry<O: Orient + Sync>(
     geo: &[u32],
 ) -> (Vec<u32>, Vec<(u32, u32)>) {
     let corners = |t: [u32; 3]| [p[t[0] as usize], p[t[1] as usize], p[t[2] as usize]];
-    let collinear = par::map(geo.len(), par::MIN_CHEAP, |i| {
+    let collinear = par::map(geo.len(), PARALLEL_FACES, |i| {
         let c = corners(faces[geo[i] as usize]);
         is_collinear(o, c[0], c[1], c[2])
     });
@@ -547,7 +557,7 @@ fn geometry<O: Orient + Sync>(
         }
     }
     // Each face's plane, made once: every face is tested against about a dozen neighbours.
-    let planar = par::map(solid.len(), par::MIN_CHEAP, |i| {
+    let planar = par::map(solid.len(), PARALLEL_FACES, |i| {
         let f = faces[solid[i] as usize];
         PlanarFace::new(o, f, corners(f))
     });
@@ -561,7 +571,7 @@ fn geometry<O: Orient + Sync>(
         }
     };
     let cells = grid.cells();
-    let chunks = if solid.len() >= par::MIN_CHEAP { 64 } else { 1 };
+    let chunks = if solid.len() >= PARALLEL_FACES { 64 } else { 1 };
     let mut crossings: Vec<(u32, u32)> = par::map(chunks, 2, |c| {
         let mut out = Vec::new();
         grid.pairs_in_cells(c * cells / chunks..(c + 1) * cells / chunks, |i, j| {
