@@ -107,11 +107,19 @@ pub enum MeshError {
     /// No triangle survived: every face the samples gave was removed as crossing another
     /// or as part of a component apart from `p0`'s.
     #[error(
-        "no triangle of the {points} sample points survived validation (the swept surface \
-         folds onto itself right at p0); try another p0 or smaller steps (dt, beta_max)"
+        "no triangle of the {points} sample points survived validation ({}); try shorter \
+         steps (dt_max, dt, beta_max) or another p0",
+        if *swept {
+            "the swept surface folds onto itself right at p0"
+        } else {
+            "the curves crossed one another near p0: steps too long for how the surface \
+             bends beyond them, as across the flat face of a flattened quadric"
+        }
     )]
     Empty {
         /// How many points the curves laid.
         points: usize,
+        /// Whether the field is not integrable at `p0` (the surface is swept, and may fold).
+        swept: bool,
     },
 }

@@ -327,8 +327,11 @@ pub fn run_observed<T: Scalar, F: NormalField<T>>(
         return Err(MeshError::Invalid(Box::new(validation)));
     }
     if mesh.triangles.is_empty() {
+        let swept = model::LocalShape::at::<T, F>(field, params.p0)
+            .is_none_or(|shape| shape.integrability_defect >= model::INTEGRABLE_DEFECT);
         return Err(MeshError::Empty {
             points: samples.points.len(),
+            swept,
         });
     }
     Ok(MeshRun {

@@ -439,3 +439,31 @@ fn spheres_mesh_alike_over_the_supported_scales_and_beyond_them_say_why() {
         }
     }
 }
+
+/// From the pole of a 31:1 flattened ellipsoid the default steps carry the curves across one
+/// another, and no triangle survives: the error says so in the terms of a level set (not of a
+/// folding swept surface) and names the step that helps, `dt_max` (with `dt_max = 0.1` a
+/// valid mesh comes out). The literal eq. 2 with angles is swept: its error, where it has
+/// one, says the surface folds.
+#[test]
+fn no_surviving_triangle_is_explained_for_level_sets_and_swept_surfaces_apart() {
+    let flat = Invariant::from_numbers(&[1.0, 1.0, 1000.0, 0.0, 0.0, 0.0]).unwrap();
+    let field = LieField::<f64>::new(&flat);
+    let mut params = MeshParams::at([0.0, 0.0, 1000f64.sqrt().recip()]);
+    let e = liemesh::run(&field, &params).unwrap_err();
+    assert!(matches!(e, MeshError::Empty { swept: false, .. }), "{e}");
+    let message = e.to_string();
+    assert!(
+        message.contains("dt_max") && !message.contains("folds"),
+        "{message}"
+    );
+    params.dt_max = Some(0.1);
+    let run = liemesh::run(&field, &params).expect("with shorter steps it meshes");
+    fuzz_checks::check_mesh(&run.mesh).unwrap();
+
+    let swept = MeshError::Empty {
+        points: 7,
+        swept: true,
+    };
+    assert!(swept.to_string().contains("folds onto itself"), "{swept}");
+}
