@@ -328,7 +328,7 @@ pub fn run_observed<T: Scalar, F: NormalField<T>>(
     }
     if mesh.triangles.is_empty() {
         let swept = model::LocalShape::at::<T, F>(field, params.p0)
-            .is_none_or(|shape| shape.integrability_defect >= model::INTEGRABLE_DEFECT);
+            .is_none_or(|shape| !shape.is_integrable());
         return Err(MeshError::Empty {
             points: samples.points.len(),
             swept,

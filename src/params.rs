@@ -7,7 +7,7 @@
 //! meshes the same way at any scale. Angles are [`Angle`]s, read and written in degrees.
 
 use crate::error::MeshError;
-use crate::model::{least_aligned_tangent, LocalShape, NormalField, INTEGRABLE_DEFECT};
+use crate::model::{least_aligned_tangent, LocalShape, NormalField};
 use crate::scalar::Scalar;
 
 /// An angle. Kept in radians; read and written in degrees wherever a person sees it (files,
@@ -382,7 +382,7 @@ impl MeshParams {
                 .unwrap_or(AUTO_DT_MIN.min(0.25 * self.beta_min.radians()) * scales.step),
             dt_max: self.dt_max.unwrap_or(AUTO_DT_MAX * scales.step),
             max_radius: self.max_radius.unwrap_or(
-                if shape.integrability_defect < INTEGRABLE_DEFECT {
+                if shape.is_integrable() {
                     AUTO_RADIUS
                 } else {
                     AUTO_RADIUS_SWEPT

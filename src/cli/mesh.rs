@@ -431,15 +431,7 @@ pub(super) fn run(args: &MeshArgs) -> Result<ExitCode, CliError> {
                     &params,
                     &e,
                 );
-                if let Some(path) = &args.report {
-                    write_json(path, &failure)?;
-                }
-                if args.json {
-                    println!(
-                        "{}",
-                        serde_json::to_string_pretty(&failure).expect("reports serialise")
-                    );
-                }
+                publish(args, &failure)?;
                 return Err(CliError::Mesh(e));
             }
             other => other?,
@@ -466,18 +458,25 @@ pub(super) fn run(args: &MeshArgs) -> Result<ExitCode, CliError> {
     );
     outcome.fill(&mut report);
     report.derivatives = derivatives;
+    publish(args, &report)?;
+    if !args.json && !args.quiet {
+        print_summary(&report, args.output.as_deref(), args.report.as_deref());
+    }
+    Ok(ExitCode::SUCCESS)
+}
+
+/// Writes `report` where `--report` says and prints it as JSON if `--json` asks.
+fn publish<S: serde::Serialize>(args: &MeshArgs, report: &S) -> Result<(), CliError> {
     if let Some(path) = &args.report {
-        write_json(path, &report)?;
+        write_json(path, report)?;
     }
     if args.json {
         println!(
             "{}",
-            serde_json::to_string_pretty(&report).expect("reports serialise")
+            serde_json::to_string_pretty(report).expect("reports serialise")
         );
-    } else if !args.quiet {
-        print_summary(&report, args.output.as_deref(), args.report.as_deref());
     }
-    Ok(ExitCode::SUCCESS)
+    Ok(())
 }
 
 /// The derivatives `--derivative` asks for: one dual-number run per number, whose mesh must

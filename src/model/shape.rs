@@ -74,6 +74,11 @@ impl LocalShape {
         })
     }
 
+    /// Whether the field is integrable here: its defect is below [`INTEGRABLE_DEFECT`].
+    pub fn is_integrable(&self) -> bool {
+        self.integrability_defect < INTEGRABLE_DEFECT
+    }
+
     /// The radius of curvature in the most curved direction, `1/|κ|max` (infinite on a flat
     /// patch).
     pub fn radius_of_curvature(&self) -> f64 {

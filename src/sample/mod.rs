@@ -13,7 +13,7 @@ mod grid;
 use crate::error::MeshError;
 use crate::geom::vec3::{dist, dot, sub};
 use crate::mesh::Provenance;
-use crate::model::{LocalShape, INTEGRABLE_DEFECT};
+use crate::model::LocalShape;
 use crate::params::{MeshParams, Method, Mode, Resolved};
 use crate::progress::{Progress, Stage, SAMPLING_REPORT_EVERY};
 use crate::scalar::{Scalar, Vec3};
@@ -747,7 +747,8 @@ impl<T: Scalar, F: NormalField<T>> Sampler<'_, T, F> {
             .clamp(-1.0, 1.0)
             .acos();
         let step = self.out.steps[last_k].dt.max(len);
-        let gap = d.norm().to_f64();
+        let norm = d.norm();
+        let gap = norm.to_f64();
         if turn > MAX_INSERT_TURN * self.params.gap * self.params.beta_max.radians()
             || gap > MAX_INSERT_SPAN * self.params.gap * step
         {
@@ -761,11 +762,11 @@ impl<T: Scalar, F: NormalField<T>> Sampler<'_, T, F> {
         // points at one θ so). (The field is probed only in that rare case.)
         if s * span < MIN_CHART_SPREAD * gap
             && LocalShape::at::<T, F>(self.field, live_c.p.to_f64())
-                .is_none_or(|shape| shape.integrability_defect >= INTEGRABLE_DEFECT)
+                .is_none_or(|shape| !shape.is_integrable())
         {
             return;
         }
-        let half = d.norm() * T::from_f64(0.5);
+        let half = norm * T::from_f64(0.5);
         let start = match trace::step_fixed(self.field, &self.cfg, &live_c.p, &d, &half) {
             Ok(p) => p,
             Err(_) => return,

@@ -133,8 +133,6 @@ pub fn triangulate<T: Scalar>(
     ))
 }
 
-use crate::model::INTEGRABLE_DEFECT;
-
 /// The working-precision points of the vertices of `mesh`, every one a sample (a mesh as
 /// [`triangulate`] makes it).
 pub(crate) fn sample_vertices<T: Scalar>(samples: &Samples<T>, mesh: &Mesh) -> Vec<Vec3<T>> {
@@ -163,8 +161,7 @@ pub(crate) fn stitch<T: Scalar, F: NormalField<T>>(
     let probes = 16.min(samples.points.len()).max(1);
     let integrable = (0..probes).all(|k| {
         let i = k * samples.points.len() / probes;
-        LocalShape::at::<T, F>(field, samples.points[i].to_f64())
-            .is_none_or(|s| s.integrability_defect < INTEGRABLE_DEFECT)
+        LocalShape::at::<T, F>(field, samples.points[i].to_f64()).is_none_or(|s| s.is_integrable())
     });
     // Ends of curves that ended on a terminal condition, a singular point or a budget.
     let rim_of = |pr: &Provenance| {
