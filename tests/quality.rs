@@ -231,7 +231,6 @@ fn the_ellipsoid_closes_watertight_from_the_tip_of_its_long_axis() {
 }
 
 #[test]
-#[ignore = "open since the stitching round: see docs/status.md"]
 fn the_ellipsoid_closes_watertight_from_its_middle_axis() {
     // From (0, 1/2, 0) the folded region on the far side spans more than a hemisphere of
     // normals: only the Gauss map lays it flat.
@@ -256,7 +255,6 @@ fn the_ellipsoid_closes_watertight_with_the_beta_band_halved() {
 }
 
 #[test]
-#[ignore = "open since the stitching round: see docs/status.md"]
 fn most_ellipsoids_close_from_any_starting_point() {
     // Axis-aligned ellipsoids with semi-axis ratios up to 4, each meshed from a random point
     // of it: from most starting points the curves cross a caustic on the far side, and the

@@ -185,9 +185,31 @@ pub(crate) fn stitch<T: Scalar, F: NormalField<T>>(
         max_radius: params.max_radius,
         max_vertices: params.max_points,
         new_points: integrable,
+        well_shaped: true,
     };
-    let (stitched, open) = stitch::stitch(mesh, vertices, &rim, &[], &growth);
+    let (mut stitched, mut open) = stitch::stitch(mesh, vertices, &rim, &[], &growth);
     if open == 0 || !integrable {
+        return stitched;
+    }
+    let improve = params.mode == crate::params::Mode::Default;
+    // The well-shaped seam can leave fronts that a seam of sharper triangles would have
+    // joined (a thin tube's far side): the stitching is tried again from the chart's mesh
+    // with every triangle down to the smallest angle competing from the start, and the result
+    // with less open boundary is kept.
+    let growth = stitch::Growth {
+        well_shaped: false,
+        ..growth
+    };
+    if let Ok((mut again, _)) = triangulate(samples, params.close, improve) {
+        let mut again_vertices = sample_vertices(samples, &again);
+        let (again_stitched, again_open) =
+            stitch::stitch(&mut again, &mut again_vertices, &rim, &[], &growth);
+        if again_open < open {
+            (*mesh, *vertices, stitched, open) =
+                (again, again_vertices, again_stitched, again_open);
+        }
+    }
+    if open == 0 {
         return stitched;
     }
     // Boundary left open between fronts that met: most often where the chart's triangles were
@@ -197,7 +219,6 @@ pub(crate) fn stitch<T: Scalar, F: NormalField<T>>(
     // vertices, at their own spacing (see the `stitch` module); the result with less open
     // boundary is kept. (Offering them always would cost the sphere's far cap, where curves
     // crowd, most of the stitching's time again, and change its mesh.)
-    let improve = params.mode == crate::params::Mode::Default;
     let Ok((mut retry, _)) = triangulate(samples, params.close, improve) else {
         return stitched;
     };

@@ -19,7 +19,13 @@
 //!
 //! Candidates that glue edges — whose new edges are already boundary edges the other way round,
 //! as when a gap is zipped shut or a hole's last triangle goes in — go first; among equals the
-//! best-shaped. Topology follows from the samples: a disc whose whole boundary meets itself
+//! best-shaped. Each round runs twice over the front: first only triangles with no angle below
+//! [`GOOD_ANGLE_DEG`] that leave, at each corner, either no wedge or one at least that wide
+//! beside them (a sliver of a wedge would force a sliver of a triangle into it later), then
+//! the rest down to [`MIN_ANGLE_DEG`] under the same rule. Where that leaves fronts that met
+//! unstitched on an integrable field, the stitching is run again from the chart's mesh with
+//! every triangle down to [`MIN_ANGLE_DEG`] competing from the start and no rule on the
+//! leftover wedges, and the result with less open boundary is kept (`triangulate::stitch`). Topology follows from the samples: a disc whose whole boundary meets itself
 //! closes into a sphere, one whose two opposite arcs meet becomes a band, one whose boundary
 //! meets in two pairs of arcs becomes a torus; boundary that faces nothing (a geodesic radius,
 //! the bounding box) stays boundary.
@@ -104,6 +110,10 @@ const MAX_CANDIDATES: usize = 24;
 const TOP_UP: usize = 48;
 /// Smallest angle of a stitched triangle, degrees.
 pub(crate) const MIN_ANGLE_DEG: f64 = 12.0;
+/// Smallest angle of a stitched triangle in each round's first pass, degrees: the
+/// triangles that make no angle below it go in first, and only what they leave is stitched
+/// down to [`MIN_ANGLE_DEG`] (a seam of 12°–20° triangles, relaxed, kept angles below 15°).
+pub(crate) const GOOD_ANGLE_DEG: f64 = 20.0;
 /// Largest angle between a stitched triangle's normal and its corners' mean field normal,
 /// degrees.
 pub(crate) const MAX_TILT_DEG: f64 = 60.0;
@@ -426,6 +436,11 @@ pub(crate) struct Growth<'f, T, F> {
     /// Whether new points may be placed at all (only where the field is integrable: on a
     /// non-integrable field there is no surface between the fronts to place them on).
     pub(crate) new_points: bool,
+    /// Whether each round first stitches only well-shaped triangles ([`GOOD_ANGLE_DEG`]) and
+    /// keeps every corner's leftover wedge at least the floor wide; without it, every
+    /// triangle down to [`MIN_ANGLE_DEG`] competes from the start (the fallback where the
+    /// well-shaped seam leaves fronts unstitched).
+    pub(crate) well_shaped: bool,
 }
 
 /// Stitches the boundary of `mesh` (triangles counter-clockwise about the field normals) to
@@ -457,60 +472,36 @@ pub(crate) fn stitch<T: Scalar, F: NormalField<T>>(
     for round in 0..=REDO_ROUNDS {
         // (Each free vertex takes about two triangles to take in.)
         let budget = 8 * (s.boundary_edges() + 2 * s.free_left()) + 64;
-        let edges: Vec<(u32, u32)> = match &opened {
-            None => s.boundary_edge_list(),
-            Some(near) => {
-                for (&(a, b), memo) in &mut s.memos {
-                    if near.contains(&a) || near.contains(&b) {
-                        memo.rejected.clear();
-                    }
-                }
-                s.boundary_edge_list()
-                    .into_iter()
-                    .filter(|(a, b)| near.contains(a) || near.contains(b))
-                    .collect()
-            }
-        };
-        for (a, b) in edges {
-            s.refresh(a, b);
-        }
         let mut steps = 0;
-        while let Some(c) = s.heap.pop() {
-            if s.memos.get(&(c.a, c.b)).map(|m| m.version) != Some(c.version) {
-                continue;
-            }
-            if steps == budget || s.visits.get() > visit_budget {
-                out.budget_hit = true;
-                s.heap.clear();
-                break;
-            }
-            steps += 1;
-            // A new point goes in on trial: the tests read it like any vertex.
-            let x = if c.x == NEW {
-                s.place_new_point(c.a, c.b)
-            } else {
-                Some(c.x)
+        // Two passes: the well-shaped triangles first, then what they leave down to the
+        // smallest angle allowed.
+        let floors: &[f64] = if s.growth.well_shaped {
+            &[GOOD_ANGLE_DEG, MIN_ANGLE_DEG]
+        } else {
+            &[MIN_ANGLE_DEG]
+        };
+        for &floor in floors {
+            s.set_floor(floor);
+            let edges: Vec<(u32, u32)> = match &opened {
+                None => s.boundary_edge_list(),
+                Some(near) => {
+                    for (&(a, b), memo) in &mut s.memos {
+                        if near.contains(&a) || near.contains(&b) {
+                            memo.rejected.clear();
+                        }
+                    }
+                    s.boundary_edge_list()
+                        .into_iter()
+                        .filter(|(a, b)| near.contains(a) || near.contains(b))
+                        .collect()
+                }
             };
-            match x {
-                Some(x) if s.acceptable(c.a, c.b, x, c.x == NEW) => {
-                    if c.x == NEW {
-                        out.vertices += 1;
-                        s.register(x, c.a, c.b);
-                    }
-                    s.add([c.b, c.a, x]);
-                    out.added += 1;
-                    s.refresh_near(c.a, c.b, x);
-                }
-                _ => {
-                    if c.x == NEW && x.is_some() {
-                        s.retract();
-                    }
-                    let rejected = &mut s.memos.entry((c.a, c.b)).or_default().rejected;
-                    if !rejected.contains(&c.x) {
-                        rejected.push(c.x);
-                    }
-                    s.refresh(c.a, c.b);
-                }
+            for (a, b) in edges {
+                s.refresh(a, b);
+            }
+            s.advance_front(&mut out, &mut steps, budget, visit_budget);
+            if out.budget_hit {
+                break;
             }
         }
         let last = round == REDO_ROUNDS;
@@ -642,6 +633,9 @@ struct RememberedScore {
     epochs: [u32; 3],
     /// The bits of the reach the score and the shape were computed for.
     reach: u64,
+    /// The bits of the angle floor the score was computed for (the shape does not depend
+    /// on it).
+    floor: u64,
     score: Option<f64>,
     /// The triangle's [`Stitcher::shape`].
     shape: Option<[f64; 3]>,
@@ -710,6 +704,9 @@ struct Stitcher<'a, 'f, T, F> {
     free: Vec<bool>,
     /// Triangles and points the proximity tests visited (see [`VISITS_PER_STEP`]).
     visits: std::cell::Cell<u64>,
+    /// The smallest angle a stitched triangle may have now, degrees: [`GOOD_ANGLE_DEG`] in
+    /// a round's first pass, [`MIN_ANGLE_DEG`] in its second.
+    floor: f64,
 }
 
 impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
@@ -805,6 +802,7 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
             heap: BinaryHeap::new(),
             wedge_memo: std::cell::Cell::new(false),
             visits: std::cell::Cell::new(0),
+            floor: MIN_ANGLE_DEG,
             wedge_angles: std::cell::RefCell::new(HashMap::default()),
             epoch: Vec::new(),
             free: is_free,
@@ -946,6 +944,69 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
         dist(pa, pb).max(0.5 * (self.local(a) + self.local(b)))
     }
 
+    /// Adds the queued candidates, best first, each after its full test, refreshing the
+    /// edges around every triangle added and an edge whose candidate failed; stops when the
+    /// queue is empty or a budget (`steps` against `budget`, the visits against
+    /// `visit_budget`) runs out, which `out` then records.
+    fn advance_front(
+        &mut self,
+        out: &mut Stitched,
+        steps: &mut usize,
+        budget: usize,
+        visit_budget: u64,
+    ) {
+        while let Some(c) = self.heap.pop() {
+            if self.memos.get(&(c.a, c.b)).map(|m| m.version) != Some(c.version) {
+                continue;
+            }
+            if *steps == budget || self.visits.get() > visit_budget {
+                out.budget_hit = true;
+                self.heap.clear();
+                break;
+            }
+            *steps += 1;
+            // A new point goes in on trial: the tests read it like any vertex.
+            let x = if c.x == NEW {
+                self.place_new_point(c.a, c.b)
+            } else {
+                Some(c.x)
+            };
+            match x {
+                Some(x) if self.acceptable(c.a, c.b, x, c.x == NEW) => {
+                    if c.x == NEW {
+                        out.vertices += 1;
+                        self.register(x, c.a, c.b);
+                    }
+                    self.add([c.b, c.a, x]);
+                    out.added += 1;
+                    self.refresh_near(c.a, c.b, x);
+                }
+                _ => {
+                    if c.x == NEW && x.is_some() {
+                        self.retract();
+                    }
+                    let rejected = &mut self.memos.entry((c.a, c.b)).or_default().rejected;
+                    if !rejected.contains(&c.x) {
+                        rejected.push(c.x);
+                    }
+                    self.refresh(c.a, c.b);
+                }
+            }
+        }
+    }
+
+    /// Sets the smallest angle of the triangles stitched from now on (degrees). A change
+    /// forgets the rejected candidates, which were decided with the old floor (remembered
+    /// scores carry their floor); queued candidates are left to their full test.
+    fn set_floor(&mut self, floor: f64) {
+        if floor != self.floor {
+            self.floor = floor;
+            for memo in self.memos.values_mut() {
+                memo.rejected.clear();
+            }
+        }
+    }
+
     /// Finds the best candidate for the boundary edge `a → b` and queues it.
     fn refresh(&mut self, a: u32, b: u32) {
         // (Taken out of the table while the candidates are scored.)
@@ -1062,11 +1123,11 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
         scores: &mut Vec<(u32, RememberedScore)>,
     ) -> Option<f64> {
         let epochs = [a, b, x].map(|v| self.epoch.get(v as usize).copied().unwrap_or(0));
-        let floor = MIN_ANGLE_DEG.to_radians();
+        let floor = self.floor.to_radians();
         let found = scores.binary_search_by_key(&x, |e| e.0);
         let shape = match found {
             Ok(i) if scores[i].1.reach == reach.to_bits() => {
-                if scores[i].1.epochs == epochs {
+                if scores[i].1.epochs == epochs && scores[i].1.floor == floor.to_bits() {
                     return scores[i].1.score;
                 }
                 scores[i].1.shape
@@ -1077,6 +1138,7 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
         let remembered = RememberedScore {
             epochs,
             reach: reach.to_bits(),
+            floor: floor.to_bits(),
             score,
             shape,
         };
@@ -1353,15 +1415,31 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
         // from x to b at a, from a to x at b, and from b to a at x (a new point has no
         // wedge yet). A hole's last triangles are ears of its loop: the exact test alone
         // decides those.
-        if min_floor > 0.0
-            && !(self.in_open_wedge(a, x, b)
+        if min_floor > 0.0 && !self.growth.well_shaped {
+            if !(self.in_open_wedge(a, x, b)
                 && self.in_open_wedge(b, a, x)
                 && (self.prov[x as usize].curve == Provenance::CLOSING_CURVE
                     && !self.on_boundary(x)
                     || self.is_free(x)
                     || self.in_open_wedge(x, b, a)))
-        {
-            return None;
+            {
+                return None;
+            }
+        } else if min_floor > 0.0 {
+            // Nor may it leave a sliver of a wedge beside it at a corner: the triangle that
+            // fills that wedge later would have its angle there.
+            let leaves_sliver = |left: Option<[f64; 2]>| {
+                left.is_none_or(|l| l.iter().any(|&w| w > 0.0 && w < min_floor))
+            };
+            let wedgeless = self.prov[x as usize].curve == Provenance::CLOSING_CURVE
+                && !self.on_boundary(x)
+                || self.is_free(x);
+            if leaves_sliver(self.open_wedge_leftovers(a, x, b))
+                || leaves_sliver(self.open_wedge_leftovers(b, a, x))
+                || !wedgeless && leaves_sliver(self.open_wedge_leftovers(x, b, a))
+            {
+                return None;
+            }
         }
         Some(4.0 * f64::from(self.glue(a, b, x)) + quantized(min_angle))
     }
@@ -1384,6 +1462,13 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
     /// do not change once a vertex is registered (and a vertex on trial, whose id may come
     /// back with another position, is never remembered).
     fn in_open_wedge(&self, v: u32, from: u32, to: u32) -> bool {
+        self.open_wedge_leftovers(v, from, to).is_some()
+    }
+
+    /// [`Self::in_open_wedge`], and if the wedge from `from` to `to` lies in an open wedge,
+    /// the angles that wedge leaves open before and after it (radians; 0 where a side is the
+    /// open wedge's own boundary edge).
+    fn open_wedge_leftovers(&self, v: u32, from: u32, to: u32) -> Option<[f64; 2]> {
         let (outs, ins) = (self.boundary.outs(v), self.boundary.ins(v));
         let p = self.pos[v as usize];
         let n = self.nrm[v as usize];
@@ -1438,11 +1523,17 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
                     }
                 });
                 if !cut {
-                    return true;
+                    let before = if z == from { 0.0 } else { ccw(az, af) };
+                    let after = if y == to {
+                        0.0
+                    } else {
+                        (wedge - ccw(az, af) - span).max(0.0)
+                    };
+                    return Some([before, after]);
                 }
             }
         }
-        false
+        None
     }
 
     /// The full test for triangle `(b, a, x)`, including the exact intersection test against
@@ -1455,7 +1546,7 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
         let reach = REACH * self.edge_scale(a, b);
         self.wedge_memo.set(!on_trial);
         let scored = self
-            .score(a, b, x, reach, MIN_ANGLE_DEG.to_radians())
+            .score(a, b, x, reach, self.floor.to_radians())
             .is_some();
         self.wedge_memo.set(false);
         scored && self.clear(a, b, x) && self.meets_nothing(a, b, x)
