@@ -22,7 +22,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     );
     println!(
         "same triangles: {}",
-        if canonical(&r64.mesh.triangles) == canonical(&rmp.mesh.triangles) {
+        if r64.mesh.canonical_triangles() == rmp.mesh.canonical_triangles() {
             "yes"
         } else {
             "no"
@@ -37,18 +37,4 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         .fold(0.0_f64, f64::max);
     println!("largest |f64 - Mpfr<256>| over the vertex coordinates: {worst:.3e}");
     Ok(())
-}
-
-/// Triangles rotated to start at their smallest index, sorted: the same triangle set compares
-/// equal however each triangle's listing starts.
-fn canonical(triangles: &[[u32; 3]]) -> Vec<[u32; 3]> {
-    let mut v: Vec<[u32; 3]> = triangles
-        .iter()
-        .map(|t| {
-            let k = (0..3).min_by_key(|&k| t[k]).unwrap();
-            [t[k], t[(k + 1) % 3], t[(k + 2) % 3]]
-        })
-        .collect();
-    v.sort_unstable();
-    v
 }

@@ -267,20 +267,9 @@ fn presets_in_f64_agree_with_mpfr256_within_1e_minus_9() {
             ids(&rmp.samples.provenance),
             "{p}"
         );
-        let canonical = |t: &[[u32; 3]]| {
-            let mut v: Vec<[u32; 3]> = t
-                .iter()
-                .map(|t| {
-                    let k = (0..3).min_by_key(|&k| t[k]).unwrap();
-                    [t[k], t[(k + 1) % 3], t[(k + 2) % 3]]
-                })
-                .collect();
-            v.sort_unstable();
-            v
-        };
         assert_eq!(
-            canonical(&r64.mesh.triangles),
-            canonical(&rmp.mesh.triangles),
+            r64.mesh.canonical_triangles(),
+            rmp.mesh.canonical_triangles(),
             "{p}"
         );
         let max_diff = |a: &[liemesh::scalar::Vec3<f64>],

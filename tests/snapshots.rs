@@ -47,17 +47,8 @@ fn snapshot_text(run: &MeshRun<f64>) -> String {
     writeln!(out, "closed: {}", topo.closed).unwrap();
     writeln!(out, "euler_characteristic: {}", topo.euler_characteristic).unwrap();
     writeln!(out, "boundary_loops: {}", topo.boundary_loops).unwrap();
-    let mut triangles: Vec<[u32; 3]> = mesh
-        .triangles
-        .iter()
-        .map(|t| {
-            let k = (0..3).min_by_key(|&k| t[k]).unwrap();
-            [t[k], t[(k + 1) % 3], t[(k + 2) % 3]]
-        })
-        .collect();
-    triangles.sort_unstable();
     writeln!(out, "triangles (a b c, counter-clockwise):").unwrap();
-    for [a, b, c] in triangles {
+    for [a, b, c] in mesh.canonical_triangles() {
         writeln!(out, "{a} {b} {c}").unwrap();
     }
     writeln!(out, "vertices (x y z):").unwrap();

@@ -75,6 +75,36 @@ pub struct Mesh {
     pub provenance: Vec<Provenance>,
 }
 
+impl Mesh {
+    /// The triangles, each rotated to start at its smallest vertex index (orientation kept),
+    /// sorted: two meshes with the same triangles compare equal however each triangle's
+    /// listing starts and in whatever order the triangles come (what a determinism or
+    /// precision comparison of two runs compares).
+    ///
+    /// ```
+    /// use liemesh::Mesh;
+    ///
+    /// let mut a = Mesh::default();
+    /// a.triangles = vec![[2, 0, 1], [3, 1, 0]];
+    /// let mut b = a.clone();
+    /// b.triangles = vec![[0, 3, 1], [0, 1, 2]];
+    /// assert_eq!(a.canonical_triangles(), [[0, 1, 2], [0, 3, 1]]);
+    /// assert_eq!(a.canonical_triangles(), b.canonical_triangles());
+    /// ```
+    pub fn canonical_triangles(&self) -> Vec<[u32; 3]> {
+        let mut v: Vec<[u32; 3]> = self
+            .triangles
+            .iter()
+            .map(|t| {
+                let k = (0..3).min_by_key(|&k| t[k]).unwrap_or(0);
+                [t[k], t[(k + 1) % 3], t[(k + 2) % 3]]
+            })
+            .collect();
+        v.sort_unstable();
+        v
+    }
+}
+
 /// The octahedron with corners ±x, ±y, ±z (vertices 0..6 = +x, −x, +y, −y, +z, −z), faces
 /// counter-clockwise seen from outside: the smallest closed mesh for unit tests.
 #[cfg(test)]
