@@ -467,3 +467,22 @@ fn no_surviving_triangle_is_explained_for_level_sets_and_swept_surfaces_apart() 
     };
     assert!(swept.to_string().contains("folds onto itself"), "{swept}");
 }
+
+/// A 7:1 flattened ellipsoid (`λ` = 1, 1, 50) from its pole and from a generic point, with
+/// defaults: closed, χ = 2. The pole is nearly flat and the rim sharp (radius 0.02), which
+/// the shape at `p0` cannot tell; before the automatic clamps knew the ellipsoid's semi-axes,
+/// the curves stopped at the rim as if at a singular point (738 of 750) and the mesh was an
+/// open disc of 6,193 triangles.
+#[test]
+fn a_flattened_ellipsoid_closes_from_its_pole_and_from_a_generic_point_with_defaults() {
+    let flat = Invariant::from_numbers(&[1.0, 1.0, 50.0, 0.0, 0.0, 0.0]).unwrap();
+    let field = LieField::<f64>::new(&flat);
+    for d in [[0.0_f64, 0.0, 1.0], [0.3, 0.5, 0.4]] {
+        let level = (d[0] * d[0] + d[1] * d[1] + 50.0 * d[2] * d[2]).sqrt();
+        let run = liemesh::run(&field, &MeshParams::at(d.map(|x| x / level))).unwrap();
+        let v = &run.validation;
+        assert!(v.is_closed() && v.euler_characteristic == 2, "{d:?}: {v}");
+        assert!(run.cut_short().is_empty(), "{d:?}: {:?}", run.cut_short());
+        assert_eq!(run.samples.ends().singular, 0, "{d:?}");
+    }
+}

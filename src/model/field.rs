@@ -57,6 +57,16 @@ pub trait NormalField<T: Scalar>: Sync {
         let _ = p0;
         None
     }
+
+    /// The semi-axes of the surface through `p0`, shortest first, when the field knows it is
+    /// an ellipsoid: the automatic step clamps then keep steps shorter than the ellipsoid is
+    /// thick and let them shrink enough for its sharpest bend (`shortest² / longest`), which
+    /// the shape at `p0` cannot tell (the pole of a flattened ellipsoid is nearly flat, its
+    /// rim is sharp). The default, `None`, leaves the clamps to the shape at `p0`.
+    fn semi_axes_through(&self, p0: [f64; 3]) -> Option<[f64; 3]> {
+        let _ = p0;
+        None
+    }
 }
 
 impl<T: Scalar, F: NormalField<T> + ?Sized> NormalField<T> for &F {
@@ -74,6 +84,9 @@ impl<T: Scalar, F: NormalField<T> + ?Sized> NormalField<T> for &F {
     }
     fn size_through(&self, p0: [f64; 3]) -> Option<f64> {
         (**self).size_through(p0)
+    }
+    fn semi_axes_through(&self, p0: [f64; 3]) -> Option<[f64; 3]> {
+        (**self).semi_axes_through(p0)
     }
 }
 
@@ -199,6 +212,35 @@ impl<T: Scalar> NormalField<T> for LieField<T> {
     /// largest semi-axis `√(c / λ)` over the eigenvalues `λ` of `A` of the sign of `c`, the
     /// directions in which it is bounded. `None` for other fields and for a cone (`c = 0`).
     fn size_through(&self, p0: [f64; 3]) -> Option<f64> {
+        let (eigenvalues, c) = self.quadric_through(p0)?;
+        let size = eigenvalues
+            .iter()
+            .filter(|&&l| l * c > 0.0 && (l.abs() > 1e-12))
+            .map(|&l| (c / l).sqrt())
+            .fold(None, |m: Option<f64>, x| Some(m.map_or(x, |m| m.max(x))));
+        size.filter(|s| s.is_finite() && *s > 0.0)
+    }
+
+    /// For a quadric that is an ellipsoid (every eigenvalue `λ` of `A` of the sign of `c`),
+    /// its semi-axes `√(c / λ)`, shortest first.
+    fn semi_axes_through(&self, p0: [f64; 3]) -> Option<[f64; 3]> {
+        let (eigenvalues, c) = self.quadric_through(p0)?;
+        if !eigenvalues.iter().all(|&l| l * c > 0.0 && l.abs() > 1e-12) {
+            return None;
+        }
+        let mut axes = eigenvalues.map(|l| (c / l).sqrt());
+        axes.sort_by(f64::total_cmp);
+        axes.iter()
+            .all(|s| s.is_finite() && *s > 0.0)
+            .then_some(axes)
+    }
+}
+
+impl<T: Scalar> LieField<T> {
+    /// For a quadric (`B = 0`, `A` symmetric), the eigenvalues of `A` and the level
+    /// `c = p0ᵀ A p0`, both for `A` scaled to entries of order one (so that the eigen solver
+    /// neither overflows nor underflows; the semi-axes `√(c / λ)` do not change).
+    fn quadric_through(&self, p0: [f64; 3]) -> Option<([f64; 3], f64)> {
         if self.quadratic {
             return None;
         }
@@ -208,19 +250,11 @@ impl<T: Scalar> NormalField<T> for LieField<T> {
         if !(symmetric && scale.is_finite() && scale > 0.0) {
             return None;
         }
-        // Scaled to entries of order one, so that the eigen solver neither overflows nor
-        // underflows; the semi-axes do not change.
         let m = nalgebra::Matrix3::from_fn(|i, j| a[i][j] / scale);
         let p = nalgebra::Vector3::from(p0);
         let c = p.dot(&(m * p));
         let eigen = nalgebra::SymmetricEigen::new(m);
-        let size = eigen
-            .eigenvalues
-            .iter()
-            .filter(|&&l| l * c > 0.0 && (l.abs() > 1e-12))
-            .map(|&l| (c / l).sqrt())
-            .fold(None, |m: Option<f64>, x| Some(m.map_or(x, |m| m.max(x))));
-        size.filter(|s| s.is_finite() && *s > 0.0)
+        Some(([0, 1, 2].map(|k| eigen.eigenvalues[k]), c))
     }
 }
 
