@@ -200,14 +200,16 @@ pub(crate) fn stitch<T: Scalar, F: NormalField<T>>(
         well_shaped: false,
         ..growth
     };
-    if let Ok((mut again, _)) = triangulate(samples, params.close, improve) {
-        let mut again_vertices = sample_vertices(samples, &again);
-        let (again_stitched, again_open) =
-            stitch::stitch(&mut again, &mut again_vertices, &rim, &[], &growth);
-        if again_open < open {
-            (*mesh, *vertices, stitched, open) =
-                (again, again_vertices, again_stitched, again_open);
-        }
+    // The chart's mesh, triangulated once more for both retries below.
+    let Ok((chart_mesh, _)) = triangulate(samples, params.close, improve) else {
+        return stitched;
+    };
+    let mut again = chart_mesh.clone();
+    let mut again_vertices = sample_vertices(samples, &again);
+    let (again_stitched, again_open) =
+        stitch::stitch(&mut again, &mut again_vertices, &rim, &[], &growth);
+    if again_open < open {
+        (*mesh, *vertices, stitched, open) = (again, again_vertices, again_stitched, again_open);
     }
     if open == 0 {
         return stitched;
@@ -219,9 +221,7 @@ pub(crate) fn stitch<T: Scalar, F: NormalField<T>>(
     // vertices, at their own spacing (see the `stitch` module); the result with less open
     // boundary is kept. (Offering them always would cost the sphere's far cap, where curves
     // crowd, most of the stitching's time again, and change its mesh.)
-    let Ok((mut retry, _)) = triangulate(samples, params.close, improve) else {
-        return stitched;
-    };
+    let mut retry = chart_mesh;
     let mut retry_vertices = sample_vertices(samples, &retry);
     let first_free = retry.vertices.len();
     let mut used = vec![false; samples.points.len()];

@@ -691,7 +691,7 @@ struct Stitcher<'a, 'f, T, F> {
     /// What [`Self::refresh`] keeps of each edge it looked at.
     memos: EdgeMap<EdgeMemo>,
     heap: BinaryHeap<Candidate>,
-    /// Whether [`Self::in_open_wedge`] remembers its angles in `wedge_angles` (only while no
+    /// Whether [`Self::open_wedge_leftovers`] remembers its angles in `wedge_angles` (only while no
     /// vertex is on trial: during a [`Self::refresh`], and in [`Self::acceptable`] for an
     /// existing vertex).
     wedge_memo: std::cell::Cell<bool>,
@@ -1415,28 +1415,19 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
         // from x to b at a, from a to x at b, and from b to a at x (a new point has no
         // wedge yet). A hole's last triangles are ears of its loop: the exact test alone
         // decides those.
-        if min_floor > 0.0 && !self.growth.well_shaped {
-            if !(self.in_open_wedge(a, x, b)
-                && self.in_open_wedge(b, a, x)
-                && (self.prov[x as usize].curve == Provenance::CLOSING_CURVE
-                    && !self.on_boundary(x)
-                    || self.is_free(x)
-                    || self.in_open_wedge(x, b, a)))
-            {
-                return None;
-            }
-        } else if min_floor > 0.0 {
-            // Nor may it leave a sliver of a wedge beside it at a corner: the triangle that
-            // fills that wedge later would have its angle there.
-            let leaves_sliver = |left: Option<[f64; 2]>| {
-                left.is_none_or(|l| l.iter().any(|&w| w > 0.0 && w < min_floor))
+        if min_floor > 0.0 {
+            // With well-shaped seams, nor may it leave a sliver of a wedge beside it at a
+            // corner: the triangle that fills that wedge later would have its angle there.
+            let slivers = self.growth.well_shaped;
+            let refused = |left: Option<[f64; 2]>| {
+                left.is_none_or(|l| slivers && l.iter().any(|&w| w > 0.0 && w < min_floor))
             };
             let wedgeless = self.prov[x as usize].curve == Provenance::CLOSING_CURVE
                 && !self.on_boundary(x)
                 || self.is_free(x);
-            if leaves_sliver(self.open_wedge_leftovers(a, x, b))
-                || leaves_sliver(self.open_wedge_leftovers(b, a, x))
-                || !wedgeless && leaves_sliver(self.open_wedge_leftovers(x, b, a))
+            if refused(self.open_wedge_leftovers(a, x, b))
+                || refused(self.open_wedge_leftovers(b, a, x))
+                || !wedgeless && refused(self.open_wedge_leftovers(x, b, a))
             {
                 return None;
             }
@@ -1450,10 +1441,12 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
         u8::from(self.is_boundary_edge(x, a)) + u8::from(self.is_boundary_edge(b, x))
     }
 
-    /// Whether the wedge at boundary vertex `v` from the direction of `from` counter-clockwise
-    /// to that of `to` (about `v`'s field normal) lies in one of `v`'s open wedges: from a
+    /// If the wedge at boundary vertex `v` from the direction of `from` counter-clockwise to
+    /// that of `to` (about `v`'s field normal) lies in one of `v`'s open wedges (from a
     /// boundary in-edge's source counter-clockwise to a boundary out-edge's target, with no
-    /// other boundary edge of `v` between.
+    /// other boundary edge of `v` between), the angles that open wedge leaves before and
+    /// after it (radians; 0 where a side is the open wedge's own boundary edge); `None` if
+    /// it lies in none.
     ///
     /// While no vertex is on trial the angles about `v` are remembered (a refresh's candidates
     /// share their edge's ends and the ends' boundary neighbours, edges near each other share
@@ -1461,13 +1454,6 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
     /// anew, since an angle reads only the positions and normals of its two vertices, which
     /// do not change once a vertex is registered (and a vertex on trial, whose id may come
     /// back with another position, is never remembered).
-    fn in_open_wedge(&self, v: u32, from: u32, to: u32) -> bool {
-        self.open_wedge_leftovers(v, from, to).is_some()
-    }
-
-    /// [`Self::in_open_wedge`], and if the wedge from `from` to `to` lies in an open wedge,
-    /// the angles that wedge leaves open before and after it (radians; 0 where a side is the
-    /// open wedge's own boundary edge).
     fn open_wedge_leftovers(&self, v: u32, from: u32, to: u32) -> Option<[f64; 2]> {
         let (outs, ins) = (self.boundary.outs(v), self.boundary.ins(v));
         let p = self.pos[v as usize];
