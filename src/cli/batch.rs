@@ -13,7 +13,7 @@ use super::progress::Status;
 use super::CliError;
 use clap::Args;
 use liemesh::io::invariant_file::InvariantFile;
-use liemesh::io::report::Report;
+use liemesh::io::report::{Job, Report};
 use liemesh::io::{self, MeshFormat, WriteOptions};
 use liemesh::scalar::ScalarKind;
 use rayon::prelude::*;
@@ -116,15 +116,8 @@ fn mesh_one(input: &Path, out: &Path, format: MeshFormat) -> Result<BatchDone, C
         &WriteOptions { ply_ascii: false },
     )?;
     // `seconds: 0.0`: the report must not depend on timing (see the module docs).
-    let mut report = Report::new(
-        None,
-        &file.invariant,
-        ScalarKind::F64,
-        &outcome.mesh,
-        outcome.curves,
-        0.0,
-        &params,
-    );
+    let job = Job::new(None, &file.invariant, ScalarKind::F64, &params);
+    let mut report = Report::new(job, &outcome.mesh, outcome.curves, 0.0);
     outcome.fill(&mut report);
     write_json(&report_path, &report)?;
     Ok(BatchDone {

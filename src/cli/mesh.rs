@@ -4,7 +4,7 @@ use super::progress::{grouped, with_progress, Status};
 use super::CliError;
 use clap::Args;
 use liemesh::io::invariant_file::InvariantFile;
-use liemesh::io::report::{FailureReport, Report, VertexDerivatives};
+use liemesh::io::report::{FailureReport, Job, Report, VertexDerivatives};
 use liemesh::io::{self, WriteOptions};
 use liemesh::model::{AngleReading, Invariant, LieField};
 use liemesh::preset::Preset;
@@ -419,18 +419,18 @@ pub(super) fn run(args: &MeshArgs) -> Result<ExitCode, CliError> {
     }
     let scalar = ScalarKind::from(args.scalar);
     let measure = args.report.is_some() || args.json;
+    let job = Job::new(
+        preset.map(|p| p.name().to_string()),
+        &invariant,
+        scalar,
+        &params,
+    );
     let (outcome, derivatives) = with_progress(args.quiet, |status| {
         let outcome = match mesh_invariant(&invariant, &params, scalar, measure, status) {
             Err(CliError::Mesh(e)) => {
                 // The report says why there is no mesh (`--report`, `--json`); the error
                 // still goes to the terminal and the exit code.
-                let failure = FailureReport::new(
-                    preset.map(|p| p.name().to_string()),
-                    &invariant,
-                    scalar,
-                    &params,
-                    &e,
-                );
+                let failure = FailureReport::new(job.clone(), &e);
                 publish(args, &failure)?;
                 return Err(CliError::Mesh(e));
             }
@@ -447,15 +447,7 @@ pub(super) fn run(args: &MeshArgs) -> Result<ExitCode, CliError> {
         }
         Ok::<_, CliError>((outcome, derivatives))
     })?;
-    let mut report = Report::new(
-        preset.map(|p| p.name().to_string()),
-        &invariant,
-        scalar,
-        &outcome.mesh,
-        outcome.curves,
-        outcome.seconds,
-        &params,
-    );
+    let mut report = Report::new(job, &outcome.mesh, outcome.curves, outcome.seconds);
     outcome.fill(&mut report);
     report.derivatives = derivatives;
     publish(args, &report)?;
@@ -599,8 +591,8 @@ pub(super) fn write_json<S: serde::Serialize>(path: &Path, value: &S) -> Result<
 }
 
 fn print_summary(r: &Report, mesh: Option<&Path>, report: Option<&Path>) {
-    let name = r.preset.as_deref().unwrap_or("invariant");
-    println!("liemesh: {name} ({} scalars)", r.scalar);
+    let name = r.job.preset.as_deref().unwrap_or("invariant");
+    println!("liemesh: {name} ({} scalars)", r.job.scalar);
     println!("  vertices   {}", r.vertices);
     println!("  triangles  {}", r.triangles);
     println!("  curves     {}", r.curves);
@@ -630,7 +622,7 @@ fn print_summary(r: &Report, mesh: Option<&Path>, report: Option<&Path>) {
         println!("  INCOMPLETE {}", r.cut_short.join("; "));
     }
     println!("  time       {:.2} ms", r.seconds * 1e3);
-    if let (Some(f), Some(limit)) = (&r.refinement, r.parameters.max_normal_error) {
+    if let (Some(f), Some(limit)) = (&r.refinement, r.job.parameters.max_normal_error) {
         let limit = limit.degrees();
         println!(
             "  refinement {} vertices in {} round{}; {}",

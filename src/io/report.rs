@@ -8,18 +8,48 @@ use crate::scalar::ScalarKind;
 use crate::triangulate::Mesh;
 use crate::MeshError;
 
-/// What a meshing run reports: counts, topology, time, and everything needed to rerun it.
+/// What a meshing run was asked to do: everything needed to run it again. Both reports
+/// start with it ([`Report`], [`FailureReport`]); in JSON its fields sit at the top level.
 #[derive(Clone, Debug, PartialEq)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
-pub struct Report {
+pub struct Job {
     /// Preset name, if the run used one.
     pub preset: Option<String>,
     /// The invariant's numbers (6 or 18).
     pub invariant: Vec<f64>,
     /// Whether `H` lies in sp(6).
     pub hamiltonian_in_sp6: bool,
-    /// Scalar type the samples were computed in.
+    /// Scalar type the run worked in.
     pub scalar: ScalarKind,
+    /// The parameters given.
+    pub parameters: MeshParams,
+}
+
+impl Job {
+    /// Meshing `invariant` with `parameters` in `scalar` (from the preset named `preset`).
+    pub fn new(
+        preset: Option<String>,
+        invariant: &Invariant,
+        scalar: ScalarKind,
+        parameters: &MeshParams,
+    ) -> Job {
+        Job {
+            preset,
+            invariant: invariant.numbers(),
+            hamiltonian_in_sp6: invariant.is_in_sp6(),
+            scalar,
+            parameters: parameters.clone(),
+        }
+    }
+}
+
+/// What a meshing run reports: counts, topology, time, and everything needed to rerun it.
+#[derive(Clone, Debug, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+pub struct Report {
+    /// What was asked.
+    #[cfg_attr(feature = "serde", serde(flatten))]
+    pub job: Job,
     /// Mesh vertices.
     pub vertices: usize,
     /// Mesh triangles.
@@ -36,8 +66,6 @@ pub struct Report {
     pub topology: Topology,
     /// Wall-clock seconds for sampling and triangulation.
     pub seconds: f64,
-    /// The parameters given.
-    pub parameters: MeshParams,
     /// The automatic parameters as worked out for this surface (`scales`, `w00`, `dt`,
     /// `dt_min`, `dt_max`, `max_radius`, `bounding_box`).
     #[cfg_attr(
@@ -85,16 +113,9 @@ pub struct Report {
 #[derive(Clone, Debug, PartialEq)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct FailureReport {
-    /// Preset name, if the run used one.
-    pub preset: Option<String>,
-    /// The invariant's numbers (6 or 18).
-    pub invariant: Vec<f64>,
-    /// Whether `H` lies in sp(6).
-    pub hamiltonian_in_sp6: bool,
-    /// Scalar type the run worked in.
-    pub scalar: ScalarKind,
-    /// The parameters given.
-    pub parameters: MeshParams,
+    /// What was asked.
+    #[cfg_attr(feature = "serde", serde(flatten))]
+    pub job: Job,
     /// Why the run failed, in the words of its [`MeshError`].
     pub error: String,
     /// The validation the mesh failed, when it came out invalid ([`MeshError::Invalid`]).
@@ -106,21 +127,10 @@ pub struct FailureReport {
 }
 
 impl FailureReport {
-    /// The report of meshing `invariant` with `parameters` in `scalar`, which failed with
-    /// `error`.
-    pub fn new(
-        preset: Option<String>,
-        invariant: &Invariant,
-        scalar: ScalarKind,
-        parameters: &MeshParams,
-        error: &MeshError,
-    ) -> FailureReport {
+    /// The report of `job`, which failed with `error`.
+    pub fn new(job: Job, error: &MeshError) -> FailureReport {
         FailureReport {
-            preset,
-            invariant: invariant.numbers(),
-            hamiltonian_in_sp6: invariant.is_in_sp6(),
-            scalar,
-            parameters: parameters.clone(),
+            job,
             error: error.to_string(),
             validation: match error {
                 MeshError::Invalid(v) => Some((**v).clone()),
@@ -168,22 +178,11 @@ impl VertexDerivatives {
 }
 
 impl Report {
-    /// Builds a report for `mesh`.
-    pub fn new(
-        preset: Option<String>,
-        invariant: &Invariant,
-        scalar: ScalarKind,
-        mesh: &Mesh,
-        curves: usize,
-        seconds: f64,
-        parameters: &MeshParams,
-    ) -> Report {
+    /// Builds the report of `job`, which made `mesh` from `curves` curves in `seconds`.
+    pub fn new(job: Job, mesh: &Mesh, curves: usize, seconds: f64) -> Report {
         let topology = Topology::of(mesh);
         Report {
-            preset,
-            invariant: invariant.numbers(),
-            hamiltonian_in_sp6: invariant.is_in_sp6(),
-            scalar,
+            job,
             vertices: mesh.vertices.len(),
             triangles: mesh.triangles.len(),
             curves,
@@ -192,7 +191,6 @@ impl Report {
             boundary_loops: topology.boundary_loops,
             topology,
             seconds,
-            parameters: parameters.clone(),
             resolved: None,
             curve_ends: Default::default(),
             cut_short: Vec::new(),

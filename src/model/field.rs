@@ -170,6 +170,26 @@ impl<T: Scalar> LieField<T> {
     pub fn c(&self) -> &Mat3<T> {
         &self.c
     }
+
+    /// For a quadric (`B = 0`, `A` symmetric), the eigenvalues of `A` and the level
+    /// `c = p0ᵀ A p0`, both for `A` scaled to entries of order one (so that the eigen solver
+    /// neither overflows nor underflows; the semi-axes `√(c / λ)` do not change).
+    fn quadric_through(&self, p0: [f64; 3]) -> Option<([f64; 3], f64)> {
+        if self.quadratic {
+            return None;
+        }
+        let a: [[f64; 3]; 3] = std::array::from_fn(|i| self.a[i].to_f64());
+        let scale = a.iter().flatten().fold(0.0_f64, |m, x| m.max(x.abs()));
+        let symmetric = (0..3).all(|i| (0..i).all(|j| (a[i][j] - a[j][i]).abs() <= 1e-12 * scale));
+        if !(symmetric && scale.is_finite() && scale > 0.0) {
+            return None;
+        }
+        let m = nalgebra::Matrix3::from_fn(|i, j| a[i][j] / scale);
+        let p = nalgebra::Vector3::from(p0);
+        let c = p.dot(&(m * p));
+        let eigen = nalgebra::SymmetricEigen::new(m);
+        Some(([0, 1, 2].map(|k| eigen.eigenvalues[k]), c))
+    }
 }
 
 #[inline(always)]
@@ -233,28 +253,6 @@ impl<T: Scalar> NormalField<T> for LieField<T> {
         axes.iter()
             .all(|s| s.is_finite() && *s > 0.0)
             .then_some(axes)
-    }
-}
-
-impl<T: Scalar> LieField<T> {
-    /// For a quadric (`B = 0`, `A` symmetric), the eigenvalues of `A` and the level
-    /// `c = p0ᵀ A p0`, both for `A` scaled to entries of order one (so that the eigen solver
-    /// neither overflows nor underflows; the semi-axes `√(c / λ)` do not change).
-    fn quadric_through(&self, p0: [f64; 3]) -> Option<([f64; 3], f64)> {
-        if self.quadratic {
-            return None;
-        }
-        let a: [[f64; 3]; 3] = std::array::from_fn(|i| self.a[i].to_f64());
-        let scale = a.iter().flatten().fold(0.0_f64, |m, x| m.max(x.abs()));
-        let symmetric = (0..3).all(|i| (0..i).all(|j| (a[i][j] - a[j][i]).abs() <= 1e-12 * scale));
-        if !(symmetric && scale.is_finite() && scale > 0.0) {
-            return None;
-        }
-        let m = nalgebra::Matrix3::from_fn(|i, j| a[i][j] / scale);
-        let p = nalgebra::Vector3::from(p0);
-        let c = p.dot(&(m * p));
-        let eigen = nalgebra::SymmetricEigen::new(m);
-        Some(([0, 1, 2].map(|k| eigen.eigenvalues[k]), c))
     }
 }
 
