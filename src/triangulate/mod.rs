@@ -16,6 +16,7 @@
 //!    the field's are split (new vertices on the surface) until none does: see
 //!    [`Refinement`].
 
+mod face_grid;
 mod flip;
 mod refine;
 mod relax;

@@ -61,6 +61,7 @@
 //! vertex is pinched until the gaps beside the bridge are closed too. Pinches that remain at the
 //! end are cut apart by removing the fewer triangles of the vertex.
 
+use super::face_grid::{cell_count, cell_of, Cell, FaceGrid};
 use crate::geom::intersect::faces_intersect;
 use crate::geom::rows::{compressed_rows, rows_by_corner};
 use crate::geom::union_find::UnionFind;
@@ -2422,8 +2423,6 @@ fn pinched_fans(triangles: &[[u32; 3]], candidate: impl Fn(u32) -> bool) -> (Vec
     (pinched, drop)
 }
 
-type Cell = (i32, i32, i32);
-
 /// Points bucketed by cubic cells (points are only ever added).
 struct PointGrid {
     inv: f64,
@@ -2433,18 +2432,6 @@ struct PointGrid {
     index: HashMap<Cell, u32, FastHash>,
     /// The cells that hold points, with their points.
     cells: Vec<(Cell, Vec<u32>)>,
-}
-
-fn cell_of(inv: f64, p: [f64; 3]) -> Cell {
-    let k = |x: f64| crate::geom::grid::floor_clamped(x * inv);
-    (k(p[0]), k(p[1]), k(p[2]))
-}
-
-/// How many cells the box of cells from `lo` to `hi` holds.
-fn cell_count(lo: Cell, hi: Cell) -> i64 {
-    (i64::from(hi.0) - i64::from(lo.0) + 1)
-        * (i64::from(hi.1) - i64::from(lo.1) + 1)
-        * (i64::from(hi.2) - i64::from(lo.2) + 1)
 }
 
 impl PointGrid {
@@ -2497,139 +2484,6 @@ impl PointGrid {
                 for z in lo.2..=hi.2 {
                     if let Some(&i) = self.index.get(&(x, y, z)) {
                         self.cells[i as usize].1.iter().for_each(|&v| f(v));
-                    }
-                }
-            }
-        }
-    }
-}
-
-/// Triangles bucketed by the cells their bounding boxes meet.
-///
-/// The chart's triangles are filed once, in compressed rows by cell (no list per cell to
-/// grow); triangles added later go to lists of their own, by row.
-struct FaceGrid {
-    inv: f64,
-    /// The row of each cell that holds a triangle.
-    rows: HashMap<Cell, u32, FastHash>,
-    /// The chart's triangles of row `r` are `filed[start[r]..start[r + 1]]`.
-    start: Vec<u32>,
-    filed: Vec<u32>,
-    /// Triangles added later, by row.
-    later: Vec<Vec<u32>>,
-    /// Triangles too large to file cell by cell: tested against every query.
-    large: Vec<u32>,
-}
-
-impl FaceGrid {
-    /// A grid of cells of side `cell` holding the triangles `tris` of the points `pos`.
-    fn new(cell: f64, pos: &[[f64; 3]], tris: &[[u32; 3]]) -> Self {
-        let mut grid = FaceGrid {
-            inv: 1.0 / cell,
-            rows: HashMap::default(),
-            start: Vec::new(),
-            filed: Vec::new(),
-            later: Vec::new(),
-            large: Vec::new(),
-        };
-        // Each vertex's cell (`None` at a non-finite coordinate): the cells of a triangle's
-        // box run from its corners' lowest cells to their highest, since a coordinate's cell
-        // never decreases as it grows.
-        let vertex_cells: Vec<Option<Cell>> = pos
-            .iter()
-            .map(|p| {
-                p.iter()
-                    .all(|x| x.is_finite())
-                    .then(|| cell_of(grid.inv, *p))
-            })
-            .collect();
-        // (row, triangle) for each cell a triangle's box meets, then grouped by row.
-        let mut entries: Vec<(u32, u32)> = Vec::with_capacity(3 * tris.len());
-        for (f, t) in tris.iter().enumerate() {
-            let (lo, hi, count) = match t.map(|v| vertex_cells[v as usize]) {
-                [Some(a), Some(b), Some(c)] => {
-                    let lo = (
-                        a.0.min(b.0).min(c.0),
-                        a.1.min(b.1).min(c.1),
-                        a.2.min(b.2).min(c.2),
-                    );
-                    let hi = (
-                        a.0.max(b.0).max(c.0),
-                        a.1.max(b.1).max(c.1),
-                        a.2.max(b.2).max(c.2),
-                    );
-                    (lo, hi, cell_count(lo, hi))
-                }
-                _ => grid.range(&corners(pos, *t)),
-            };
-            if count > 64 {
-                grid.large.push(f as u32);
-                continue;
-            }
-            for x in lo.0..=hi.0 {
-                for y in lo.1..=hi.1 {
-                    for z in lo.2..=hi.2 {
-                        let next = grid.rows.len() as u32;
-                        let row = *grid.rows.entry((x, y, z)).or_insert(next);
-                        entries.push((row, f as u32));
-                    }
-                }
-            }
-        }
-        let rows = grid.rows.len();
-        let (start, filed) = compressed_rows(rows, entries.iter().map(|&(r, f)| (r as usize, f)))
-            .expect("every entry's row is one of the grid's");
-        grid.start = start;
-        grid.filed = filed;
-        grid.later = vec![Vec::new(); rows];
-        grid
-    }
-    fn range(&self, c: &[[f64; 3]; 3]) -> (Cell, Cell, i64) {
-        let lo = [0, 1, 2].map(|k| c[0][k].min(c[1][k]).min(c[2][k]));
-        let hi = [0, 1, 2].map(|k| c[0][k].max(c[1][k]).max(c[2][k]));
-        let (lo, hi) = (cell_of(self.inv, lo), cell_of(self.inv, hi));
-        (lo, hi, cell_count(lo, hi))
-    }
-    fn insert(&mut self, f: u32, c: [[f64; 3]; 3]) {
-        let (lo, hi, count) = self.range(&c);
-        if count > 64 {
-            self.large.push(f);
-            return;
-        }
-        for x in lo.0..=hi.0 {
-            for y in lo.1..=hi.1 {
-                for z in lo.2..=hi.2 {
-                    let row = match self.rows.entry((x, y, z)) {
-                        std::collections::hash_map::Entry::Occupied(e) => *e.get(),
-                        std::collections::hash_map::Entry::Vacant(e) => {
-                            // A new row, with none of the chart's triangles.
-                            self.start.push(self.filed.len() as u32);
-                            self.later.push(Vec::new());
-                            *e.insert(self.later.len() as u32 - 1)
-                        }
-                    };
-                    self.later[row as usize].push(f);
-                }
-            }
-        }
-    }
-    /// Calls `f` for every triangle filed in a cell the box of `c` meets (maybe repeatedly,
-    /// in no particular order).
-    fn near(&self, c: &[[f64; 3]; 3], mut f: impl FnMut(u32)) {
-        let (lo, hi, count) = self.range(c);
-        self.large.iter().for_each(|&t| f(t));
-        if count > 4096 {
-            self.filed.iter().for_each(|&t| f(t));
-            self.later.iter().flatten().for_each(|&t| f(t));
-            return;
-        }
-        for x in lo.0..=hi.0 {
-            for y in lo.1..=hi.1 {
-                for z in lo.2..=hi.2 {
-                    if let Some(&r) = self.rows.get(&(x, y, z)) {
-                        let r = r as usize;
-                        let chart = &self.filed[self.start[r] as usize..self.start[r + 1] as usize];
-                        chart.iter().chain(&self.later[r]).for_each(|&t| f(t));
                     }
                 }
             }

@@ -1,0 +1,334 @@
+//! Triangles bucketed by cubic cells of several sizes: the stitcher's proximity index.
+//!
+//! A triangle is filed at the finest level whose cells it spans few of (at most
+//! [`MAX_CELLS_PER_FACE`]), level `k` having cells `4^k` times the base cell's side; a query
+//! visits the cells its box meets at every level that holds a triangle. On a mesh of
+//! triangles of about one size every triangle lands on the base level and this is the
+//! one-level grid it was. Where sizes differ by orders of magnitude (a flattened ellipsoid's
+//! rim against its faces, a hyperboloid's narrow waist), the large triangles no longer sit
+//! in one list that every query visits: on `[1, 1, 100, 0, 0, 0]` from `(1, 0, 0)` that list
+//! made the stitching spend its whole budget of visits before it closed the surface.
+
+use crate::geom::rows::compressed_rows;
+use crate::geom::vec3::FastHash;
+use std::collections::HashMap;
+
+/// A cell's integer coordinates (at the base level, or a coarser one).
+pub(super) type Cell = (i32, i32, i32);
+
+/// The base-level cell of point `p` for cells of side `1 / inv`.
+pub(super) fn cell_of(inv: f64, p: [f64; 3]) -> Cell {
+    let k = |x: f64| crate::geom::grid::floor_clamped(x * inv);
+    (k(p[0]), k(p[1]), k(p[2]))
+}
+
+/// How many cells the box of cells from `lo` to `hi` holds (saturating: a box from corner
+/// to corner of the clamped range holds more than an `i64` counts).
+pub(super) fn cell_count(lo: Cell, hi: Cell) -> i64 {
+    let side = |a: i32, b: i32| i64::from(b) - i64::from(a) + 1;
+    side(lo.0, hi.0)
+        .saturating_mul(side(lo.1, hi.1))
+        .saturating_mul(side(lo.2, hi.2))
+}
+
+/// A triangle is filed at the finest level where its box meets at most this many cells.
+const MAX_CELLS_PER_FACE: i64 = 64;
+/// A query whose box meets more cells than this at a level visits that level's every
+/// triangle instead.
+const MAX_CELLS_PER_QUERY: i64 = 4096;
+/// Each level's cells are `2^LEVEL_BITS` times as wide as the level below's.
+const LEVEL_BITS: u32 = 2;
+/// Levels above the base one: cells up to `4^16 ≈ 4·10⁹` base cells wide.
+const MAX_LEVEL: u32 = 16;
+
+/// The cell at `level` that holds base-level cell `c` (floor division by `4^level`).
+fn coarse(c: Cell, level: u32) -> Cell {
+    let s = LEVEL_BITS * level;
+    (c.0 >> s, c.1 >> s, c.2 >> s)
+}
+
+/// The triangles filed at one level.
+///
+/// The triangles given at construction are filed once, in compressed rows by cell (no list
+/// per cell to grow); triangles inserted later go to lists of their own, by row.
+struct Level {
+    /// The row of each cell that holds a triangle.
+    rows: HashMap<Cell, u32, FastHash>,
+    /// The first triangles of row `r` are `filed[start[r]..start[r + 1]]`.
+    start: Vec<u32>,
+    filed: Vec<u32>,
+    /// Triangles inserted later, by row.
+    later: Vec<Vec<u32>>,
+    /// Whether any triangle is filed here.
+    used: bool,
+}
+
+impl Default for Level {
+    /// No triangle: no row (`start` holds the end of the last row).
+    fn default() -> Self {
+        Level {
+            rows: HashMap::default(),
+            start: vec![0],
+            filed: Vec::new(),
+            later: Vec::new(),
+            used: false,
+        }
+    }
+}
+
+impl Level {
+    /// Calls `f` for every triangle filed in a cell from `lo` to `hi` (cells of this level).
+    fn near(&self, lo: Cell, hi: Cell, f: &mut impl FnMut(u32)) {
+        if cell_count(lo, hi) > MAX_CELLS_PER_QUERY {
+            self.filed.iter().for_each(|&t| f(t));
+            self.later.iter().flatten().for_each(|&t| f(t));
+            return;
+        }
+        for x in lo.0..=hi.0 {
+            for y in lo.1..=hi.1 {
+                for z in lo.2..=hi.2 {
+                    if let Some(&r) = self.rows.get(&(x, y, z)) {
+                        let r = r as usize;
+                        let first = &self.filed[self.start[r] as usize..self.start[r + 1] as usize];
+                        first.iter().chain(&self.later[r]).for_each(|&t| f(t));
+                    }
+                }
+            }
+        }
+    }
+
+    fn insert(&mut self, f: u32, lo: Cell, hi: Cell) {
+        self.used = true;
+        for x in lo.0..=hi.0 {
+            for y in lo.1..=hi.1 {
+                for z in lo.2..=hi.2 {
+                    let row = match self.rows.entry((x, y, z)) {
+                        std::collections::hash_map::Entry::Occupied(e) => *e.get(),
+                        std::collections::hash_map::Entry::Vacant(e) => {
+                            // A new row, with none of the first triangles.
+                            self.start.push(self.filed.len() as u32);
+                            self.later.push(Vec::new());
+                            *e.insert(self.later.len() as u32 - 1)
+                        }
+                    };
+                    self.later[row as usize].push(f);
+                }
+            }
+        }
+    }
+}
+
+/// Triangles bucketed by the cells their bounding boxes meet, at several cell sizes (see
+/// the module docs).
+pub(super) struct FaceGrid {
+    inv: f64,
+    levels: Vec<Level>,
+    /// Triangles that fit no level (a corner not finite, or a box wider than the coarsest
+    /// cells): visited by every query.
+    unfiled: Vec<u32>,
+}
+
+impl FaceGrid {
+    /// A grid of base cells of side `cell` holding the triangles `tris` of the points `pos`.
+    pub(super) fn new(cell: f64, pos: &[[f64; 3]], tris: &[[u32; 3]]) -> Self {
+        let inv = 1.0 / cell;
+        let mut grid = FaceGrid {
+            inv,
+            levels: Vec::new(),
+            unfiled: Vec::new(),
+        };
+        // Each vertex's base cell (`None` at a non-finite coordinate): the cells of a
+        // triangle's box run from its corners' lowest cells to their highest, since a
+        // coordinate's cell never decreases as it grows.
+        let vertex_cells: Vec<Option<Cell>> = pos
+            .iter()
+            .map(|p| p.iter().all(|x| x.is_finite()).then(|| cell_of(inv, *p)))
+            .collect();
+        // (row, triangle) for each cell a triangle's box meets, by level.
+        let mut entries: Vec<Vec<(u32, u32)>> = Vec::new();
+        for (f, t) in tris.iter().enumerate() {
+            let [Some(a), Some(b), Some(c)] = t.map(|v| vertex_cells[v as usize]) else {
+                grid.unfiled.push(f as u32);
+                continue;
+            };
+            let lo = (
+                a.0.min(b.0).min(c.0),
+                a.1.min(b.1).min(c.1),
+                a.2.min(b.2).min(c.2),
+            );
+            let hi = (
+                a.0.max(b.0).max(c.0),
+                a.1.max(b.1).max(c.1),
+                a.2.max(b.2).max(c.2),
+            );
+            let Some((level, lo, hi)) = grid.level_for(lo, hi) else {
+                grid.unfiled.push(f as u32);
+                continue;
+            };
+            if entries.len() <= level {
+                entries.resize_with(level + 1, Vec::new);
+            }
+            let rows = &mut grid.levels[level].rows;
+            for x in lo.0..=hi.0 {
+                for y in lo.1..=hi.1 {
+                    for z in lo.2..=hi.2 {
+                        let next = rows.len() as u32;
+                        let row = *rows.entry((x, y, z)).or_insert(next);
+                        entries[level].push((row, f as u32));
+                    }
+                }
+            }
+        }
+        for (level, entries) in grid.levels.iter_mut().zip(&entries) {
+            let rows = level.rows.len();
+            let (start, filed) =
+                compressed_rows(rows, entries.iter().map(|&(r, f)| (r as usize, f)))
+                    .expect("every entry's row is one of the level's");
+            level.used = !filed.is_empty();
+            level.start = start;
+            level.filed = filed;
+            level.later = vec![Vec::new(); rows];
+        }
+        grid
+    }
+
+    /// The finest level at which the box of base cells from `lo` to `hi` meets at most
+    /// [`MAX_CELLS_PER_FACE`] cells, and the box's cells there; the levels up to it exist
+    /// afterwards. `None` if none does.
+    fn level_for(&mut self, lo: Cell, hi: Cell) -> Option<(usize, Cell, Cell)> {
+        let level = (0..=MAX_LEVEL)
+            .find(|&k| cell_count(coarse(lo, k), coarse(hi, k)) <= MAX_CELLS_PER_FACE)?;
+        let k = level as usize;
+        if self.levels.len() <= k {
+            self.levels.resize_with(k + 1, Level::default);
+        }
+        Some((k, coarse(lo, level), coarse(hi, level)))
+    }
+
+    /// The base cells of the box of the points `c`.
+    fn range(&self, c: &[[f64; 3]]) -> (Cell, Cell) {
+        let lo = [0, 1, 2].map(|k| c.iter().map(|p| p[k]).fold(f64::INFINITY, f64::min));
+        let hi = [0, 1, 2].map(|k| c.iter().map(|p| p[k]).fold(f64::NEG_INFINITY, f64::max));
+        (cell_of(self.inv, lo), cell_of(self.inv, hi))
+    }
+
+    /// Files triangle `f` with corners `c`.
+    pub(super) fn insert(&mut self, f: u32, c: [[f64; 3]; 3]) {
+        if !c.iter().flatten().all(|x| x.is_finite()) {
+            self.unfiled.push(f);
+            return;
+        }
+        let (lo, hi) = self.range(&c);
+        match self.level_for(lo, hi) {
+            Some((level, lo, hi)) => self.levels[level].insert(f, lo, hi),
+            None => self.unfiled.push(f),
+        }
+    }
+
+    /// Calls `f` for every triangle filed in a cell the box of the points `c` meets (maybe
+    /// repeatedly, in no particular order).
+    pub(super) fn near(&self, c: &[[f64; 3]], mut f: impl FnMut(u32)) {
+        self.unfiled.iter().for_each(|&t| f(t));
+        let (lo, hi) = self.range(c);
+        for (k, level) in self.levels.iter().enumerate().filter(|(_, l)| l.used) {
+            let k = k as u32;
+            level.near(coarse(lo, k), coarse(hi, k), &mut f);
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Every triangle whose box meets the query's box is visited, whatever its size.
+    #[test]
+    fn queries_find_small_and_large_triangles_alike() {
+        let pos = vec![
+            [0.0, 0.0, 0.0],
+            [0.1, 0.0, 0.0],
+            [0.0, 0.1, 0.0],
+            [-50.0, -50.0, 0.0],
+            [50.0, -50.0, 0.0],
+            [0.0, 50.0, 0.0],
+            [200.0, 200.0, 200.0],
+            [200.1, 200.0, 200.0],
+            [200.0, 200.1, 200.0],
+        ];
+        let tris = [[0, 1, 2], [3, 4, 5]];
+        let mut grid = FaceGrid::new(0.1, &pos, &tris);
+        grid.insert(2, [pos[6], pos[7], pos[8]]);
+        // A level that only later insertions use.
+        grid.insert(4, [[-5e3, -5e3, 0.0], [5e3, -5e3, 0.0], [0.0, 5e3, 0.0]]);
+        grid.insert(3, [[f64::NAN; 3], pos[7], pos[8]]);
+        // The large triangle went to a coarser level, not to the list every query visits.
+        assert!(grid.levels.len() > 1 && grid.unfiled == [3]);
+        let found = |q: [[f64; 3]; 2]| {
+            let mut seen = Vec::new();
+            grid.near(&q, |t| seen.push(t));
+            seen.sort_unstable();
+            seen.dedup();
+            seen
+        };
+        // (Boxes are tested, not triangles: the large one's cells hold all the others.)
+        assert_eq!(found([[0.01, 0.01, 0.0], [0.02, 0.02, 0.0]]), [0, 1, 3, 4]);
+        assert_eq!(found([[30.0, -40.0, -0.1], [30.5, -39.5, 0.1]]), [1, 3, 4]);
+        let far = [[200.05, 200.05, 200.0], [200.06, 200.06, 200.0]];
+        assert_eq!(found(far), [2, 3, 4]);
+        assert_eq!(
+            found([[4e3, 4e3, 1.0], [4e3 + 0.05, 4e3 + 0.05, 1.05]]),
+            [3, 4]
+        );
+        assert_eq!(
+            found([[4e4, 4e4, 1.0], [4e4 + 0.05, 4e4 + 0.05, 1.05]]),
+            [3]
+        );
+        // A query of many cells at a level visits that level's every triangle.
+        assert_eq!(
+            found([[-1e6, -1e6, -1e6], [1e6, 1e6, 1e6]]),
+            [0, 1, 2, 3, 4]
+        );
+    }
+
+    /// Against brute force, on triangles whose sizes span six orders of magnitude, filed at
+    /// construction and inserted later: every triangle whose box meets the query's box is
+    /// visited.
+    #[test]
+    fn queries_visit_every_triangle_whose_box_meets_theirs() {
+        let mut rng = crate::geom::rng::XorShift64::new(7);
+        let mut pos = Vec::new();
+        let mut tris = Vec::new();
+        for t in 0..600u32 {
+            let size = 10f64.powf(rng.uniform(-3.0, 3.0));
+            let centre = rng.in_cube(100.0);
+            for _ in 0..3 {
+                let d = rng.in_cube(size);
+                pos.push([0, 1, 2].map(|k| centre[k] + d[k]));
+            }
+            tris.push([3 * t, 3 * t + 1, 3 * t + 2]);
+        }
+        let corners = |t: [u32; 3]| t.map(|v| pos[v as usize]);
+        let mut grid = FaceGrid::new(0.05, &pos, &tris[..300]);
+        for (f, &t) in tris.iter().enumerate().skip(300) {
+            grid.insert(f as u32, corners(t));
+        }
+        let boxed = |c: &[[f64; 3]]| {
+            let lo = [0, 1, 2].map(|k| c.iter().map(|p| p[k]).fold(f64::INFINITY, f64::min));
+            let hi = [0, 1, 2].map(|k| c.iter().map(|p| p[k]).fold(f64::NEG_INFINITY, f64::max));
+            (lo, hi)
+        };
+        for _ in 0..300 {
+            let size = 10f64.powf(rng.uniform(-3.0, 2.0));
+            let (a, b) = (rng.in_cube(100.0), rng.in_cube(size));
+            let query = [a, [0, 1, 2].map(|k| a[k] + b[k])];
+            let mut seen = vec![false; tris.len()];
+            grid.near(&query, |t| seen[t as usize] = true);
+            let (qlo, qhi) = boxed(&query);
+            for (f, &t) in tris.iter().enumerate() {
+                let (lo, hi) = boxed(&corners(t));
+                let meets = (0..3).all(|k| lo[k] <= qhi[k] && qlo[k] <= hi[k]);
+                assert!(!meets || seen[f], "triangle {f} missed by {query:?}");
+            }
+        }
+    }
+}
