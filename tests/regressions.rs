@@ -486,3 +486,22 @@ fn a_flattened_ellipsoid_closes_from_its_pole_and_from_a_generic_point_with_defa
         assert_eq!(run.samples.ends().singular, 0, "{d:?}");
     }
 }
+
+/// A 10:1 oblate ellipsoid (`λ` = 1, 1, 100) from a point of its rim, with defaults: closed,
+/// χ = 2. The rim bends with radius 0.01, sharper than the triangles (about 0.05) can follow,
+/// and the fronts that meet there left two holes of one triangle each, twisted across the rim
+/// (one corner's normal 88° from the triangle's), which no ear passed. Before the stitcher's
+/// face grid filed triangles by size, the stitching ran out of its budget there (four loops,
+/// 75 edges).
+#[test]
+fn a_ten_to_one_oblate_ellipsoid_closes_from_its_rim_with_defaults() {
+    let flat = Invariant::from_numbers(&[1.0, 1.0, 100.0, 0.0, 0.0, 0.0]).unwrap();
+    let run = liemesh::run(
+        &LieField::<f64>::new(&flat),
+        &MeshParams::at([1.0, 0.0, 0.0]),
+    )
+    .unwrap();
+    let v = &run.validation;
+    assert!(v.is_closed() && v.euler_characteristic == 2, "{v}");
+    assert!(run.cut_short().is_empty(), "{:?}", run.cut_short());
+}

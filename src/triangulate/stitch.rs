@@ -1602,6 +1602,15 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
         !crowded
     }
 
+    /// Whether the triangle that closes the three-edge loop `ring` faces the same side as the
+    /// field normal at each of its corners (however far it tilts) and meets nothing.
+    fn last_triangle_fits(&self, ring: &[u32]) -> bool {
+        let t = [ring[2], ring[1], ring[0]];
+        let [pa, pb, pc] = corners(&self.pos, t);
+        let face = cross(sub(pb, pa), sub(pc, pa));
+        t.iter().all(|&v| dot(face, self.nrm[v as usize]) > 0.0) && self.face_meets_nothing(t)
+    }
+
     /// Closes the boundary loops that are left, ear by ear (the best-shaped ear first), as
     /// long as the ears face the way the field does, meet nothing and cover no other vertex of
     /// the loop: the last few triangles where fronts met may have to be thin. Loops of at most
@@ -1639,6 +1648,13 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
                     // corners' normals far apart) takes a point on the surface in its middle.
                     if m <= FAN_HOLE && self.fill_by_fan(&ring) {
                         added += m;
+                    } else if m == 3 && self.last_triangle_fits(&ring) {
+                        // A hole of one missing triangle across a bend sharper than the
+                        // triangles (a flattened ellipsoid's rim): that triangle goes in if
+                        // it faces the same side as each corner's normal and meets nothing,
+                        // however far it tilts.
+                        self.add([ring[2], ring[1], ring[0]]);
+                        added += 1;
                     }
                     break;
                 };
