@@ -39,6 +39,10 @@
 //! thin torus's ring), instead of growing its own points across it; the try with less open
 //! boundary is kept (`triangulate::stitch`).
 //!
+//! A hole of one missing triangle that no ear closes (its corners on both sides of a bend
+//! sharper than the triangles, such as a flattened ellipsoid's rim) takes that triangle if it
+//! faces the same side as each corner's normal and meets nothing, however far it tilts.
+//!
 //! Where holes are left that no ear closes (triangles twisted around them), the triangles
 //! around them are removed and the front runs again, over a few rounds that each open one ring
 //! wider (only on an integrable field: without new points the removed triangles could not be
