@@ -164,7 +164,7 @@ const FENCE_THICKNESS: f64 = 0.35;
 /// arc length (see [`Beside`]): the closure test's.
 const BESIDE_FENCE_RADIUS: f64 = COLLISION_RADIUS;
 
-/// The curves on either side of a step and the step's arc length, in the previous method.
+/// The curves on either side of a step and the step's arc length (previous method only).
 /// Where its curves converge (towards a sphere's far pole), neighbours at the same arc
 /// length come closer in space than a step while the chart, which spaces them by `s·Δθ`,
 /// calls them far apart: the full fence would stop every other curve there a few steps
@@ -177,6 +177,14 @@ const BESIDE_FENCE_RADIUS: f64 = COLLISION_RADIUS;
 struct Beside {
     curves: [u32; 2],
     s: f64,
+}
+
+impl Beside {
+    /// Whether the point of provenance `pr` is on a curve beside the step, within two steps
+    /// of length `len` of its arc length.
+    fn beside(&self, pr: &Provenance, len: f64) -> bool {
+        self.curves.contains(&pr.curve) && (pr.s - self.s).abs() <= 2.0 * len
+    }
 }
 
 /// A bound on squared distances beyond which the distance (`d².sqrt()`, as `dist` computes
@@ -489,10 +497,10 @@ impl<T: Scalar, F: NormalField<T>> Sampler<'_, T, F> {
                 // Paper mode: curves drift off the surface, by different amounts.
                 Some(_) => self.collides(q, chart_q, len, normal, drift),
                 None => {
-                    let beside = Beside {
+                    let beside = (self.params.method == Method::Previous).then_some(Beside {
                         curves: [live.left, live.right],
                         s: s_new,
-                    };
+                    });
                     self.crosses(live.p.to_f64(), q, chart_q, len, beside)
                 }
             }
@@ -649,9 +657,8 @@ impl<T: Scalar, F: NormalField<T>> Sampler<'_, T, F> {
         q: [f64; 3],
         chart_q: [f64; 2],
         len: f64,
-        beside: Beside,
+        beside: Option<Beside>,
     ) -> bool {
-        let previous = self.params.method == Method::Previous;
         // Every point within the fence radius of the segment is within this of its middle.
         let e = sub(q, p);
         let half = 0.5 * dot(e, e).sqrt();
@@ -675,14 +682,9 @@ impl<T: Scalar, F: NormalField<T>> Sampler<'_, T, F> {
             }
             let nj = self.nrm[j];
             let (sp, sq) = (dot(sub(p, xj), nj), dot(sub(q, xj), nj));
-            let pj = &self.out.provenance[j];
-            let radius = if previous
-                && beside.curves.contains(&pj.curve)
-                && (pj.s - beside.s).abs() <= 2.0 * len
-            {
-                BESIDE_FENCE_RADIUS * len
-            } else {
-                radius
+            let radius = match beside {
+                Some(b) if b.beside(&self.out.provenance[j], len) => BESIDE_FENCE_RADIUS * len,
+                _ => radius,
             };
             let onto = sq.abs() < thickness && dq < radius;
             let through = ((sp > 0.0 && sq < 0.0) || (sp < 0.0 && sq > 0.0)) && {
@@ -829,7 +831,8 @@ impl<T: Scalar, F: NormalField<T>> Sampler<'_, T, F> {
         if self.params.close
             && match normal {
                 Some(_) => self.collides(start_f, chart, len, normal, drift),
-                None => self.crosses(start_f, start_f, chart, len, Beside { curves: [c, k], s }),
+                // (Only the proposed method inserts curves.)
+                None => self.crosses(start_f, start_f, chart, len, None),
             }
         {
             return;

@@ -16,8 +16,8 @@
 //!    the field's are split (new vertices on the surface) until none does: see
 //!    [`Refinement`].
 
-mod face_grid;
 mod flip;
+mod proximity;
 mod refine;
 mod relax;
 mod stitch;

@@ -25,10 +25,12 @@
 //! the rest down to [`MIN_ANGLE_DEG`] under the same rule. Where that leaves fronts that met
 //! unstitched on an integrable field, the stitching is run again from the chart's mesh with
 //! every triangle down to [`MIN_ANGLE_DEG`] competing from the start and no rule on the
-//! leftover wedges, and the result with less open boundary is kept (`triangulate::stitch`). Topology follows from the samples: a disc whose whole boundary meets itself
-//! closes into a sphere, one whose two opposite arcs meet becomes a band, one whose boundary
-//! meets in two pairs of arcs becomes a torus; boundary that faces nothing (a geodesic radius,
-//! the bounding box) stays boundary.
+//! leftover wedges, and the result with less open boundary is kept (`triangulate::stitch`).
+//!
+//! Topology follows from the samples: a disc whose whole boundary meets itself closes into a
+//! sphere, one whose two opposite arcs meet becomes a band, one whose boundary meets in two
+//! pairs of arcs becomes a torus; boundary that faces nothing (a geodesic radius, the bounding
+//! box) stays boundary.
 //!
 //! Where the front leaves boundary open between fronts that met, the stitching is tried once
 //! more from the chart's triangles with the samples the chart left without one offered as
@@ -65,7 +67,7 @@
 //! vertex is pinched until the gaps beside the bridge are closed too. Pinches that remain at the
 //! end are cut apart by removing the fewer triangles of the vertex.
 
-use super::face_grid::{cell_count, cell_of, Cell, FaceGrid};
+use super::proximity::{FaceGrid, PointGrid};
 use crate::geom::intersect::faces_intersect;
 use crate::geom::rows::{compressed_rows, rows_by_corner};
 use crate::geom::union_find::UnionFind;
@@ -1606,13 +1608,14 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
         !crowded
     }
 
-    /// Whether the triangle that closes the three-edge loop `ring` faces the same side as the
+    /// The triangle that closes the three-edge loop `ring`, if it faces the same side as the
     /// field normal at each of its corners (however far it tilts) and meets nothing.
-    fn last_triangle_fits(&self, ring: &[u32]) -> bool {
+    fn last_triangle(&self, ring: &[u32]) -> Option<[u32; 3]> {
         let t = [ring[2], ring[1], ring[0]];
         let [pa, pb, pc] = corners(&self.pos, t);
         let face = cross(sub(pb, pa), sub(pc, pa));
-        t.iter().all(|&v| dot(face, self.nrm[v as usize]) > 0.0) && self.face_meets_nothing(t)
+        (t.iter().all(|&v| dot(face, self.nrm[v as usize]) > 0.0) && self.face_meets_nothing(t))
+            .then_some(t)
     }
 
     /// Closes the boundary loops that are left, ear by ear (the best-shaped ear first), as
@@ -1652,12 +1655,12 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
                     // corners' normals far apart) takes a point on the surface in its middle.
                     if m <= FAN_HOLE && self.fill_by_fan(&ring) {
                         added += m;
-                    } else if m == 3 && self.last_triangle_fits(&ring) {
+                    } else if let Some(t) = (m == 3).then(|| self.last_triangle(&ring)).flatten() {
                         // A hole of one missing triangle across a bend sharper than the
                         // triangles (a flattened ellipsoid's rim): that triangle goes in if
                         // it faces the same side as each corner's normal and meets nothing,
                         // however far it tilts.
-                        self.add([ring[2], ring[1], ring[0]]);
+                        self.add(t);
                         added += 1;
                     }
                     break;
@@ -2441,72 +2444,4 @@ fn pinched_fans(triangles: &[[u32; 3]], candidate: impl Fn(u32) -> bool) -> (Vec
     drop.sort_unstable();
     drop.dedup();
     (pinched, drop)
-}
-
-/// Points bucketed by cubic cells (points are only ever added).
-struct PointGrid {
-    inv: f64,
-    /// The points, in the order they were filed.
-    filed: Vec<u32>,
-    /// The index in `cells` of each cell that holds a point.
-    index: HashMap<Cell, u32, FastHash>,
-    /// The cells that hold points, with their points.
-    cells: Vec<(Cell, Vec<u32>)>,
-}
-
-impl PointGrid {
-    fn new(cell: f64) -> Self {
-        PointGrid {
-            inv: 1.0 / cell,
-            filed: Vec::new(),
-            index: HashMap::default(),
-            cells: Vec::new(),
-        }
-    }
-    /// How many points it holds.
-    fn len(&self) -> usize {
-        self.filed.len()
-    }
-    /// The points filed after the first `n`.
-    fn filed_since(&self, n: usize) -> &[u32] {
-        &self.filed[n..]
-    }
-    fn insert(&mut self, v: u32, p: [f64; 3]) {
-        self.filed.push(v);
-        let cell = cell_of(self.inv, p);
-        let next = self.cells.len() as u32;
-        let i = *self.index.entry(cell).or_insert(next);
-        if i == next {
-            self.cells.push((cell, Vec::new()));
-        }
-        self.cells[i as usize].1.push(v);
-    }
-    /// Calls `f` for every point within distance `r` of `p`, and for some others near it
-    /// (those whose cells meet the box of radius `r` about `p`, and maybe those of the cells
-    /// next to it), in no particular order.
-    fn near(&self, p: [f64; 3], r: f64, mut f: impl FnMut(u32)) {
-        let lo = cell_of(self.inv, p.map(|x| x - r));
-        let hi = cell_of(self.inv, p.map(|x| x + r));
-        if cell_count(lo, hi) > self.cells.len() as i64 {
-            // Fewer cells hold points than the box covers: those cells are scanned instead.
-            // A cell two or more beyond the box on some axis is a whole cell farther than `r`
-            // from `p`, far beyond any rounding, so none of its points is within `r`.
-            let within = |c: i32, lo: i32, hi: i32| lo - 1 <= c && c <= hi + 1;
-            for (c, list) in &self.cells {
-                if within(c.0, lo.0, hi.0) && within(c.1, lo.1, hi.1) && within(c.2, lo.2, hi.2) {
-                    list.iter().for_each(|&v| f(v));
-                }
-            }
-            return;
-        }
-        for x in lo.0..=hi.0 {
-            for y in lo.1..=hi.1 {
-                for z in lo.2..=hi.2 {
-                    if let Some(&i) = self.index.get(&(x, y, z)) {
-                        self.cells[i as usize].1.iter().for_each(|&v| f(v));
-                    }
-                }
-            }
-        }
-    }
 }

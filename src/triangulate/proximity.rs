@@ -1,30 +1,31 @@
-//! Triangles bucketed by cubic cells of several sizes: the stitcher's proximity index.
+//! The stitcher's proximity indexes: points, and triangles, bucketed by cubic cells.
 //!
-//! A triangle is filed at the finest level whose cells it spans few of (at most
+//! Points ([`PointGrid`]) are filed in cells of one size. Triangles ([`FaceGrid`]) are filed
+//! at the finest of several levels whose cells they span few of (at most
 //! [`MAX_CELLS_PER_FACE`]), level `k` having cells `4^k` times the base cell's side; a query
 //! visits the cells its box meets at every level that holds a triangle. On a mesh of
-//! triangles of about one size every triangle lands on the base level and this is the
-//! one-level grid it was. Where sizes differ by orders of magnitude (a flattened ellipsoid's
-//! rim against its faces, a hyperboloid's narrow waist), the large triangles no longer sit
-//! in one list that every query visits: on `[1, 1, 100, 0, 0, 0]` from `(1, 0, 0)` that list
-//! made the stitching spend its whole budget of visits before it closed the surface.
+//! triangles of about one size every triangle lands on the base level and this is a
+//! one-level grid. Where sizes differ by orders of magnitude (a flattened ellipsoid's rim
+//! against its faces, a hyperboloid's narrow waist), the large triangles do not sit in one
+//! list that every query visits: on `[1, 1, 100, 0, 0, 0]` from `(1, 0, 0)` such a list made
+//! the stitching spend its whole budget of visits before it closed the surface.
 
 use crate::geom::rows::compressed_rows;
 use crate::geom::vec3::FastHash;
 use std::collections::HashMap;
 
 /// A cell's integer coordinates (at the base level, or a coarser one).
-pub(super) type Cell = (i32, i32, i32);
+type Cell = (i32, i32, i32);
 
 /// The base-level cell of point `p` for cells of side `1 / inv`.
-pub(super) fn cell_of(inv: f64, p: [f64; 3]) -> Cell {
+fn cell_of(inv: f64, p: [f64; 3]) -> Cell {
     let k = |x: f64| crate::geom::grid::floor_clamped(x * inv);
     (k(p[0]), k(p[1]), k(p[2]))
 }
 
 /// How many cells the box of cells from `lo` to `hi` holds (saturating: a box from corner
 /// to corner of the clamped range holds more than an `i64` counts).
-pub(super) fn cell_count(lo: Cell, hi: Cell) -> i64 {
+fn cell_count(lo: Cell, hi: Cell) -> i64 {
     let side = |a: i32, b: i32| i64::from(b) - i64::from(a) + 1;
     side(lo.0, hi.0)
         .saturating_mul(side(lo.1, hi.1))
@@ -59,8 +60,6 @@ struct Level {
     filed: Vec<u32>,
     /// Triangles inserted later, by row.
     later: Vec<Vec<u32>>,
-    /// Whether any triangle is filed here.
-    used: bool,
 }
 
 impl Default for Level {
@@ -71,12 +70,16 @@ impl Default for Level {
             start: vec![0],
             filed: Vec::new(),
             later: Vec::new(),
-            used: false,
         }
     }
 }
 
 impl Level {
+    /// Whether any triangle is filed here (a row is made only for a triangle).
+    fn used(&self) -> bool {
+        !self.rows.is_empty()
+    }
+
     /// Calls `f` for every triangle filed in a cell from `lo` to `hi` (cells of this level).
     fn near(&self, lo: Cell, hi: Cell, f: &mut impl FnMut(u32)) {
         if cell_count(lo, hi) > MAX_CELLS_PER_QUERY {
@@ -98,7 +101,6 @@ impl Level {
     }
 
     fn insert(&mut self, f: u32, lo: Cell, hi: Cell) {
-        self.used = true;
         for x in lo.0..=hi.0 {
             for y in lo.1..=hi.1 {
                 for z in lo.2..=hi.2 {
@@ -184,7 +186,6 @@ impl FaceGrid {
             let (start, filed) =
                 compressed_rows(rows, entries.iter().map(|&(r, f)| (r as usize, f)))
                     .expect("every entry's row is one of the level's");
-            level.used = !filed.is_empty();
             level.start = start;
             level.filed = filed;
             level.later = vec![Vec::new(); rows];
@@ -230,9 +231,77 @@ impl FaceGrid {
     pub(super) fn near(&self, c: &[[f64; 3]], mut f: impl FnMut(u32)) {
         self.unfiled.iter().for_each(|&t| f(t));
         let (lo, hi) = self.range(c);
-        for (k, level) in self.levels.iter().enumerate().filter(|(_, l)| l.used) {
+        for (k, level) in self.levels.iter().enumerate().filter(|(_, l)| l.used()) {
             let k = k as u32;
             level.near(coarse(lo, k), coarse(hi, k), &mut f);
+        }
+    }
+}
+
+/// Points bucketed by cubic cells (points are only ever added).
+pub(super) struct PointGrid {
+    inv: f64,
+    /// The points, in the order they were filed.
+    filed: Vec<u32>,
+    /// The index in `cells` of each cell that holds a point.
+    index: HashMap<Cell, u32, FastHash>,
+    /// The cells that hold points, with their points.
+    cells: Vec<(Cell, Vec<u32>)>,
+}
+
+impl PointGrid {
+    pub(super) fn new(cell: f64) -> Self {
+        PointGrid {
+            inv: 1.0 / cell,
+            filed: Vec::new(),
+            index: HashMap::default(),
+            cells: Vec::new(),
+        }
+    }
+    /// How many points it holds.
+    pub(super) fn len(&self) -> usize {
+        self.filed.len()
+    }
+    /// The points filed after the first `n`.
+    pub(super) fn filed_since(&self, n: usize) -> &[u32] {
+        &self.filed[n..]
+    }
+    pub(super) fn insert(&mut self, v: u32, p: [f64; 3]) {
+        self.filed.push(v);
+        let cell = cell_of(self.inv, p);
+        let next = self.cells.len() as u32;
+        let i = *self.index.entry(cell).or_insert(next);
+        if i == next {
+            self.cells.push((cell, Vec::new()));
+        }
+        self.cells[i as usize].1.push(v);
+    }
+    /// Calls `f` for every point within distance `r` of `p`, and for some others near it
+    /// (those whose cells meet the box of radius `r` about `p`, and maybe those of the cells
+    /// next to it), in no particular order.
+    pub(super) fn near(&self, p: [f64; 3], r: f64, mut f: impl FnMut(u32)) {
+        let lo = cell_of(self.inv, p.map(|x| x - r));
+        let hi = cell_of(self.inv, p.map(|x| x + r));
+        if cell_count(lo, hi) > self.cells.len() as i64 {
+            // Fewer cells hold points than the box covers: those cells are scanned instead.
+            // A cell two or more beyond the box on some axis is a whole cell farther than `r`
+            // from `p`, far beyond any rounding, so none of its points is within `r`.
+            let within = |c: i32, lo: i32, hi: i32| lo - 1 <= c && c <= hi + 1;
+            for (c, list) in &self.cells {
+                if within(c.0, lo.0, hi.0) && within(c.1, lo.1, hi.1) && within(c.2, lo.2, hi.2) {
+                    list.iter().for_each(|&v| f(v));
+                }
+            }
+            return;
+        }
+        for x in lo.0..=hi.0 {
+            for y in lo.1..=hi.1 {
+                for z in lo.2..=hi.2 {
+                    if let Some(&i) = self.index.get(&(x, y, z)) {
+                        self.cells[i as usize].1.iter().for_each(|&v| f(v));
+                    }
+                }
+            }
         }
     }
 }
