@@ -24,6 +24,10 @@ pub struct StepConfig<T> {
     dt_min: T,
     dt_max: T,
     max_retries: usize,
+    /// `cos(OVERSHOOT · β_max)`, and whether that angle is below a half turn (else no step
+    /// overshoots).
+    overshoot_cos: f64,
+    overshoot_possible: bool,
 }
 
 impl<T: Scalar> StepConfig<T> {
@@ -40,6 +44,8 @@ impl<T: Scalar> StepConfig<T> {
             dt_min: T::from_f64(params.dt_min),
             dt_max: T::from_f64(params.dt_max),
             max_retries: params.max_retries,
+            overshoot_cos: (OVERSHOOT * params.beta_max.radians()).cos(),
+            overshoot_possible: OVERSHOOT * params.beta_max.radians() < std::f64::consts::PI,
         }
     }
 
@@ -68,6 +74,16 @@ pub enum StepStop {
 /// How many times a default-mode step halves its length when the chord's Newton solve finds
 /// no root, before the curve ends with [`StepStop::NoChord`].
 pub const CHORD_HALVINGS: u32 = 3;
+
+/// A default-mode step whose normal turned by more than this many times `β_max` (measured at
+/// the chord's end, not predicted) is cut to a fraction of its length and taken again, up to
+/// [`OVERSHOOT_CUTS`] times and not below `dt_min`: the closed-form length trusts the
+/// first-order prediction, which misses a turn that the field makes within the step (a fold
+/// or a near-singular point on a swept surface). Such steps crossed a 90° turn in one step
+/// on Hamiltonian fields far from the origin, and the chart's triangles between them folded.
+pub const OVERSHOOT: f64 = 2.0;
+/// How many times a default-mode step that overshot ([`OVERSHOOT`]) is cut.
+pub const OVERSHOOT_CUTS: u32 = 8;
 
 /// A Newton correction within this many tolerances that is more than half the one before it
 /// marks the rounding floor of the chord equation: `G` is evaluated with rounding noise, and
@@ -123,6 +139,30 @@ pub fn unit_normal<T: Scalar, F: NormalField<T>>(
         Some((n, len)) => Ok((v, n, len)),
         None => Err(StepStop::SingularNormal),
     }
+}
+
+/// Whether the angle between `a` and `b` exceeds the angle whose cosine is `limit_cos`
+/// (false if either vanishes or is not finite).
+#[inline]
+fn overshot(a: [f64; 3], b: [f64; 3], limit_cos: f64) -> bool {
+    let dot = a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+    let norms = ((a[0] * a[0] + a[1] * a[1] + a[2] * a[2])
+        * (b[0] * b[0] + b[1] * b[1] + b[2] * b[2]))
+        .sqrt();
+    norms > 0.0 && norms.is_finite() && dot < limit_cos * norms
+}
+
+/// The angle between `a` and `b`, radians (NaN if either vanishes).
+fn angle_between(a: [f64; 3], b: [f64; 3]) -> f64 {
+    let dot = a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+    let cross = [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ];
+    (cross[0] * cross[0] + cross[1] * cross[1] + cross[2] * cross[2])
+        .sqrt()
+        .atan2(dot)
 }
 
 /// `normalize(v + Δt J_v w)` in `f64` (the zero vector if that vanishes or is not finite).
@@ -250,17 +290,38 @@ pub fn step<T: Scalar, F: NormalField<T>>(
             };
             let mut chord = drift_free_chord(field, cfg, &start, &dt, &kappa)?;
             let mut iterations = chord.iterations;
-            // No root near the osculating circle's chord: the field turns too fast over Δt.
-            // A shorter chord turns less; the step is marked as limited by the budget.
-            let mut halvings = 0;
-            while !chord.converged {
-                let half = dt.clone() * T::from_f64(0.5);
-                if halvings == CHORD_HALVINGS || half < cfg.dt_min {
-                    return Err(StepStop::NoChord);
+            let v_start = v.to_f64();
+            let (mut halvings, mut cuts) = (0, 0);
+            loop {
+                if !chord.converged {
+                    // No root near the osculating circle's chord: the field turns too fast
+                    // over Δt. A shorter chord turns less; the step is marked as limited by
+                    // the budget.
+                    let half = dt.clone() * T::from_f64(0.5);
+                    if halvings == CHORD_HALVINGS || half < cfg.dt_min {
+                        return Err(StepStop::NoChord);
+                    }
+                    halvings += 1;
+                    dt = half;
+                    limit = StepLimit::Budget;
+                } else {
+                    // The turn the step made, against the band (see `OVERSHOOT`): a cosine
+                    // comparison first, the angle only for a step that overshot.
+                    if !cfg.overshoot_possible
+                        || cuts == OVERSHOOT_CUTS
+                        || !overshot(v_start, chord.end_field, cfg.overshoot_cos)
+                    {
+                        break;
+                    }
+                    let turned = angle_between(v_start, chord.end_field);
+                    let overshoot = OVERSHOOT * cfg.beta_max.to_f64();
+                    let cut = dt.clone() * T::from_f64((overshoot / turned).clamp(0.1, 0.5));
+                    if cut < cfg.dt_min {
+                        break;
+                    }
+                    cuts += 1;
+                    dt = cut;
                 }
-                halvings += 1;
-                dt = half;
-                limit = StepLimit::Budget;
                 chord = drift_free_chord(field, cfg, &start, &dt, &kappa)?;
                 iterations += chord.iterations;
             }
@@ -341,6 +402,8 @@ pub fn step_fixed<T: Scalar, F: NormalField<T>>(
 struct Chord<T> {
     point: Vec3<T>,
     direction: Vec3<T>,
+    /// The field at the chord's end as of Newton's last iteration (in `f64`).
+    end_field: [f64; 3],
     iterations: u32,
     /// Whether Newton's method found the root (else the point is wherever it stopped).
     converged: bool,
@@ -435,6 +498,7 @@ fn drift_free_chord<T: Scalar, F: NormalField<T>>(
     Ok(Chord {
         point,
         direction,
+        end_field: root.end_field,
         iterations: root.iterations,
         converged: root.converged,
     })
@@ -457,6 +521,8 @@ struct ChordAngle<T> {
     phi: T,
     sin: T,
     cos: T,
+    /// The field at the chord's end for the last iteration's `φ`, in `f64`.
+    end_field: [f64; 3],
     iterations: u32,
     converged: bool,
     /// Every correction after the first was smaller than the one before it (what a seed
@@ -508,6 +574,7 @@ fn chord_angle<T: Scalar, F: NormalField<T>>(
     // solve (no previous correction to judge it by).
     let mut keep: Option<(T, f64)> = seed_derivative.map(|d| (d, f64::INFINITY));
     let mut derivative = None;
+    let mut end_field = [f64::NAN; 3];
     let (mut iterations, mut converged, mut settled) = (0, false, true);
     while !converged && (iterations as usize) < budget {
         iterations += 1;
@@ -522,7 +589,9 @@ fn chord_angle<T: Scalar, F: NormalField<T>>(
             Some((dg, _)) => {
                 let mut sum = field.normal(&pm).scale(&four); // (v0 + 4 vm) + v1
                 sum += v0;
-                sum += &field.normal(&p1);
+                let v1 = field.normal(&p1);
+                end_field = v1.to_f64();
+                sum += &v1;
                 (sum, dg.clone())
             }
             None => {
@@ -530,6 +599,7 @@ fn chord_angle<T: Scalar, F: NormalField<T>>(
                 perp.sub_scaled_assign(&s, w);
                 let (vm, jm) = field.normal_and_jvp(&pm, &perp);
                 let (v1, j1) = field.normal_and_jvp(&p1, &perp);
+                end_field = v1.to_f64();
                 let mut sum = vm.scale(&four); // (v0 + 4 vm) + v1
                 sum += v0;
                 sum += &v1;
@@ -595,6 +665,7 @@ fn chord_angle<T: Scalar, F: NormalField<T>>(
         phi,
         sin: s,
         cos: c,
+        end_field,
         iterations,
         converged,
         settled,
