@@ -505,3 +505,21 @@ fn a_ten_to_one_oblate_ellipsoid_closes_from_its_rim_with_defaults() {
     assert!(v.is_closed() && v.euler_characteristic == 2, "{v}");
     assert!(run.cut_short().is_empty(), "{:?}", run.cut_short());
 }
+
+/// The same with unequal long axes (`λ` = 1, 2, 100) from `(1, 0, 0)`: 16 chart triangles
+/// bridged the top and bottom sheets 0.05 inside the rim, where the sheets' normals (147°
+/// apart) summed to about the triangles' own, so the fold test passed them and the mesh had
+/// two handles (χ = −4, two loops of 37 edges). Chart triangles whose corners' normals are
+/// more than 120° apart now go with the folds, and the stitching closes the rim.
+#[test]
+fn a_ten_to_one_oblate_ellipsoid_with_unequal_axes_closes_from_its_rim() {
+    let flat = Invariant::from_numbers(&[1.0, 2.0, 100.0, 0.0, 0.0, 0.0]).unwrap();
+    let run = liemesh::run(
+        &LieField::<f64>::new(&flat),
+        &MeshParams::at([1.0, 0.0, 0.0]),
+    )
+    .unwrap();
+    let v = &run.validation;
+    assert!(v.is_closed() && v.euler_characteristic == 2, "{v}");
+    assert!(run.cut_short().is_empty(), "{:?}", run.cut_short());
+}

@@ -266,14 +266,37 @@ pub(crate) fn stitch<T: Scalar, F: NormalField<T>>(
 /// folds.
 const FOLD_DEG: f64 = 60.0;
 
-/// Removes the chart triangles that fold ([`FOLD_DEG`]) and every triangle that shares a
-/// corner with one.
+/// Chart triangles whose corners' field normals are further apart than this bridge two
+/// sheets of the surface: adjacent samples differ by a step's turn (a few degrees), so only a
+/// triangle between samples that are not neighbours on the surface spans such a turn. The
+/// face test alone lets one through where the two sheets' normals sum to its own, as across
+/// the rim of a flattened ellipsoid (`[1, 2, 100]` from `(1, 0, 0)`: handles where the rim
+/// should be).
+const BRIDGE_DEG: f64 = 120.0;
+
+/// Whether two corners of `t` have field normals further apart than the angle whose cosine
+/// is `limit_cos` (a corner without a normal is not compared).
+fn bridges(normals: &[[f64; 3]], t: [u32; 3], limit_cos: f64) -> bool {
+    let n = t.map(|v| normals[v as usize]);
+    (0..3).any(|k| {
+        let (a, b) = (n[k], n[(k + 1) % 3]);
+        let dot = a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+        let norms = ((a[0] * a[0] + a[1] * a[1] + a[2] * a[2])
+            * (b[0] * b[0] + b[1] * b[1] + b[2] * b[2]))
+            .sqrt();
+        norms > 0.0 && dot < limit_cos * norms
+    })
+}
+
+/// Removes the chart triangles that fold ([`FOLD_DEG`]) or bridge two sheets
+/// ([`BRIDGE_DEG`]), and every triangle that shares a corner with one.
 fn drop_folds(pos: &[[f64; 3]], normals: &[[f64; 3]], triangles: &mut Vec<[u32; 3]>) {
     let limit = FOLD_DEG.to_radians().cos();
     let mut bad = vec![false; pos.len()];
     let mut any = false;
+    let spread_limit = BRIDGE_DEG.to_radians().cos();
     for &t in triangles.iter() {
-        if flip::agreement(pos, normals, t) < limit {
+        if flip::agreement(pos, normals, t) < limit || bridges(normals, t, spread_limit) {
             any = true;
             for v in t {
                 bad[v as usize] = true;
