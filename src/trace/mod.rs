@@ -6,7 +6,8 @@
 //! 3. one forward-mode JVP `J_v(p_i) w_i`, reused for every trial Δt;
 //! 4. the predicted normal `v_i + Δt J_v w_i` (eq. 8–9) and its angle α to `v_i` choose Δt;
 //! 5. the new point: `p_i + Δt w_i` in [`Mode::Paper`] (eq. 6), or a drift-free chord of
-//!    length Δt in [`Mode::Default`].
+//!    length Δt in [`Mode::Default`]. A default-mode step whose normal, measured at the
+//!    chord's end, turned by more than [`OVERSHOOT`] times `β_max` is cut and taken again.
 
 use crate::params::{Mode, Resolved};
 use crate::scalar::{self, Scalar, Vec3};
