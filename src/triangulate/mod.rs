@@ -945,4 +945,43 @@ mod tests {
         }
         assert!(slivers > 1000, "{slivers}");
     }
+
+    /// A triangle across the two sheets of a thin disc (top and bottom normals 147° apart)
+    /// goes with the folds, and so do its corner-sharing neighbours, although its face agrees
+    /// with the sum of its corners' normals; a triangle whose corners' normals differ by a
+    /// step's turn stays.
+    #[test]
+    fn a_chart_triangle_across_two_sheets_is_dropped_as_a_fold() {
+        let (s, c) = (147.0f64.to_radians() / 2.0).sin_cos();
+        let (up, down) = ([c, 0.0, s], [c, 0.0, -s]);
+        // Corners 0 and 1 on the top sheet near the rim, 2 on the bottom one; 3 beside them
+        // on top; 4, 5, 6 on top farther in.
+        let pos = [
+            [0.95, -0.05, 0.03],
+            [0.95, 0.05, 0.03],
+            [0.95, 0.0, -0.03],
+            [0.85, 0.0, 0.035],
+            [0.5, 0.0, 0.05],
+            [0.6, 0.0, 0.05],
+            [0.5, 0.1, 0.05],
+        ];
+        let normals = [up, up, down, up, up, up, up];
+        // The bridge faces +x (outward), within 60° of its corners' summed normal.
+        let bridge = [0, 2, 1];
+        assert!(flip::agreement(&pos, &normals, bridge) > FOLD_DEG.to_radians().cos());
+        let beside = [3, 0, 1];
+        let apart = [4, 5, 6];
+        assert!(flip::agreement(&pos, &normals, apart) > FOLD_DEG.to_radians().cos());
+        let mut triangles = vec![bridge, beside, apart];
+        drop_folds(&pos, &normals, &mut triangles);
+        // The bridge and the triangle sharing its corners go; the one apart from it stays.
+        assert_eq!(triangles, vec![apart]);
+        let turned = [0.6, 0.0, 0.8];
+        assert!(!bridges(
+            &[up, up, turned],
+            [0, 1, 2],
+            BRIDGE_DEG.to_radians().cos()
+        ));
+        assert!(bridges(&normals, bridge, BRIDGE_DEG.to_radians().cos()));
+    }
 }
