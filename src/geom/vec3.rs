@@ -30,6 +30,15 @@ pub(crate) fn normalize(a: [f64; 3]) -> [f64; 3] {
     [a[0] / l, a[1] / l, a[2] / l]
 }
 
+/// Whether the angle between `a` and `b` exceeds the angle whose cosine is `limit_cos`:
+/// `a·b < limit_cos |a| |b|`, without an arc cosine. False when either vector is zero or
+/// not finite.
+#[inline]
+pub(crate) fn wider_than(a: [f64; 3], b: [f64; 3], limit_cos: f64) -> bool {
+    let norms = (dot(a, a) * dot(b, b)).sqrt();
+    norms > 0.0 && norms.is_finite() && dot(a, b) < limit_cos * norms
+}
+
 /// `|a − b|`.
 #[inline]
 pub(crate) fn dist(a: [f64; 3], b: [f64; 3]) -> f64 {

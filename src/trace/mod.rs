@@ -9,6 +9,7 @@
 //!    length Δt in [`Mode::Default`]. A default-mode step whose normal, measured at the
 //!    chord's end, turned by more than [`OVERSHOOT`] times `β_max` is cut and taken again.
 
+use crate::geom::vec3::wider_than;
 use crate::params::{Mode, Resolved};
 use crate::scalar::{self, Scalar, Vec3};
 use crate::NormalField;
@@ -25,10 +26,9 @@ pub struct StepConfig<T> {
     dt_min: T,
     dt_max: T,
     max_retries: usize,
-    /// `cos(OVERSHOOT · β_max)`, and whether that angle is below a half turn (else no step
-    /// overshoots).
+    /// `cos(OVERSHOOT · β_max)`; −∞ when that angle is a half turn or more (no step
+    /// overshoots it).
     overshoot_cos: f64,
-    overshoot_possible: bool,
 }
 
 impl<T: Scalar> StepConfig<T> {
@@ -45,8 +45,14 @@ impl<T: Scalar> StepConfig<T> {
             dt_min: T::from_f64(params.dt_min),
             dt_max: T::from_f64(params.dt_max),
             max_retries: params.max_retries,
-            overshoot_cos: (OVERSHOOT * params.beta_max.radians()).cos(),
-            overshoot_possible: OVERSHOOT * params.beta_max.radians() < std::f64::consts::PI,
+            overshoot_cos: {
+                let angle = OVERSHOOT * params.beta_max.radians();
+                if angle < std::f64::consts::PI {
+                    angle.cos()
+                } else {
+                    f64::NEG_INFINITY
+                }
+            },
         }
     }
 
@@ -140,30 +146,6 @@ pub fn unit_normal<T: Scalar, F: NormalField<T>>(
         Some((n, len)) => Ok((v, n, len)),
         None => Err(StepStop::SingularNormal),
     }
-}
-
-/// Whether the angle between `a` and `b` exceeds the angle whose cosine is `limit_cos`
-/// (false if either vanishes or is not finite).
-#[inline]
-fn overshot(a: [f64; 3], b: [f64; 3], limit_cos: f64) -> bool {
-    let dot = a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
-    let norms = ((a[0] * a[0] + a[1] * a[1] + a[2] * a[2])
-        * (b[0] * b[0] + b[1] * b[1] + b[2] * b[2]))
-        .sqrt();
-    norms > 0.0 && norms.is_finite() && dot < limit_cos * norms
-}
-
-/// The angle between `a` and `b`, radians (NaN if either vanishes).
-fn angle_between(a: [f64; 3], b: [f64; 3]) -> f64 {
-    let dot = a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
-    let cross = [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ];
-    (cross[0] * cross[0] + cross[1] * cross[1] + cross[2] * cross[2])
-        .sqrt()
-        .atan2(dot)
 }
 
 /// `normalize(v + Δt J_v w)` in `f64` (the zero vector if that vanishes or is not finite).
@@ -308,13 +290,13 @@ pub fn step<T: Scalar, F: NormalField<T>>(
                 } else {
                     // The turn the step made, against the band (see `OVERSHOOT`): a cosine
                     // comparison first, the angle only for a step that overshot.
-                    if !cfg.overshoot_possible
-                        || cuts == OVERSHOOT_CUTS
-                        || !overshot(v_start, chord.end_field, cfg.overshoot_cos)
+                    if cuts == OVERSHOOT_CUTS
+                        || !wider_than(v_start, chord.end_field, cfg.overshoot_cos)
                     {
                         break;
                     }
-                    let turned = angle_between(v_start, chord.end_field);
+                    let turned =
+                        Vec3::<f64>::from_f64(v_start).angle_to(&Vec3::from_f64(chord.end_field));
                     let overshoot = OVERSHOOT * cfg.beta_max.to_f64();
                     let cut = dt.clone() * T::from_f64((overshoot / turned).clamp(0.1, 0.5));
                     if cut < cfg.dt_min {
@@ -329,7 +311,7 @@ pub fn step<T: Scalar, F: NormalField<T>>(
             // α only reports on the closed-form Δt here, so `f64` is enough (and it is the
             // same number for `f64` and `Dual<f64>`); MPFR is spared an arc tangent.
             let alpha = {
-                let (v, jw) = (Vec3::from_f64(v.to_f64()), Vec3::from_f64(jw.to_f64()));
+                let (v, jw) = (Vec3::from_f64(v_start), Vec3::from_f64(jw.to_f64()));
                 v.angle_to(&v.add_scaled(&dt.to_f64(), &jw))
             };
             if limit == StepLimit::None

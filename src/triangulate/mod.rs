@@ -38,7 +38,7 @@ pub(crate) use crate::mesh::octahedron;
 pub use crate::mesh::{Mesh, Provenance};
 
 use crate::error::MeshError;
-use crate::geom::vec3::{cross as cross3, dist as dist3, sub as sub3};
+use crate::geom::vec3::{cross as cross3, dist as dist3, sub as sub3, wider_than};
 use crate::model::LocalShape;
 use crate::params::Resolved;
 use crate::sample::{CurveEnd, Samples};
@@ -278,14 +278,7 @@ const BRIDGE_DEG: f64 = 120.0;
 /// is `limit_cos` (a corner without a normal is not compared).
 fn bridges(normals: &[[f64; 3]], t: [u32; 3], limit_cos: f64) -> bool {
     let n = t.map(|v| normals[v as usize]);
-    (0..3).any(|k| {
-        let (a, b) = (n[k], n[(k + 1) % 3]);
-        let dot = a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
-        let norms = ((a[0] * a[0] + a[1] * a[1] + a[2] * a[2])
-            * (b[0] * b[0] + b[1] * b[1] + b[2] * b[2]))
-            .sqrt();
-        norms > 0.0 && dot < limit_cos * norms
-    })
+    (0..3).any(|k| wider_than(n[k], n[(k + 1) % 3], limit_cos))
 }
 
 /// Removes the chart triangles that fold ([`FOLD_DEG`]) or bridge two sheets
