@@ -252,6 +252,28 @@ impl Scales {
         Scales { extent, step }
     }
 
+    /// The farthest from the origin of the centres of curvature at `p0` (`p0 − n/κ` for each
+    /// principal curvature `κ`) that lie within 16 extents of it, if one is farther than the
+    /// extent: a surface reaches about that far round its centres of curvature (the default
+    /// of [`NormalField::size_through`]). A torus meshed from its inner equator is near the origin, yet bends round
+    /// its tube's centre, as far out as the ring (`R` against `R − a`): with the extent of
+    /// `p0` alone, the bounding box cut a fat torus's outer half off. Farther centres (a
+    /// nearly flat direction) tell nothing.
+    pub fn centres_reach(&self, p0: [f64; 3], shape: &LocalShape) -> Option<f64> {
+        let n = shape.normal;
+        shape
+            .curvatures
+            .iter()
+            .filter(|k| k.is_finite() && **k != 0.0)
+            .map(|k| {
+                let c = [0, 1, 2].map(|i| p0[i] - n[i] / k);
+                (c[0] * c[0] + c[1] * c[1] + c[2] * c[2]).sqrt()
+            })
+            .filter(|d| d.is_finite() && *d <= CENTRE_REACH * self.extent)
+            .fold(None, |m: Option<f64>, d| Some(m.map_or(d, |m| m.max(d))))
+            .filter(|&d| d > self.extent)
+    }
+
     /// The scales with the extent raised to `size` when the field knows how far its surface
     /// reaches ([`NormalField::size_through`]); the step scale stays the local one.
     pub fn reaching(self, size: Option<f64>) -> Scales {
@@ -332,6 +354,9 @@ const AUTO_RADIUS: f64 = 4.0 * std::f64::consts::PI;
 /// itself within about this radius, and what lies beyond is laid only to be cut away.
 const AUTO_RADIUS_SWEPT: f64 = std::f64::consts::PI;
 const AUTO_BOX: f64 = 6.0;
+/// Centres of curvature up to this many extents (of the shape at `p0`) from the origin raise
+/// the extent ([`Scales::centres_reach`]).
+const CENTRE_REACH: f64 = 16.0;
 
 impl MeshParams {
     /// The defaults, from `p0`.

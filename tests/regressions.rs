@@ -528,3 +528,44 @@ fn assert_closes_from_rim(lambda: [f64; 3]) {
         run.cut_short()
     );
 }
+
+/// The torus `(√(x² + y²) − R)² + z² = a²` as the gradient of its quartic, over 4.
+#[derive(Clone)]
+struct QuarticTorus {
+    big: f64,
+    small: f64,
+}
+
+impl liemesh::model::FieldFormula for QuarticTorus {
+    fn normal<T: liemesh::scalar::Scalar>(&self, p: &Vec3<T>) -> Vec3<T> {
+        let c = |x: f64| T::from_f64(x);
+        let s = p.norm_squared() + c(self.big * self.big - self.small * self.small);
+        let r2 = c(2.0 * self.big * self.big);
+        Vec3::new(
+            p.x.clone() * (s.clone() - r2.clone()),
+            p.y.clone() * (s.clone() - r2),
+            p.z.clone() * s,
+        )
+    }
+}
+
+/// Found by trying fat tori from every side: from a point of the inner equator of a torus
+/// whose ring is barely wider than its tube (R/a = 1.15 and 1.3, `p0` 0.13 and 0.23 from the
+/// origin), the automatic bounding box (6 extents of `p0`: 0.78 and 1.38) cut off the outer
+/// half, reaching out to 1.87 and 1.77, and the mesh was an open band (χ = 0, two loops) or
+/// had two holes more (χ = −4). A user field's default `size_through` now raises the
+/// extent to the farthest centre of curvature at `p0`: here the tube's centre, on the ring.
+#[test]
+fn a_fat_torus_closes_from_its_inner_equator_with_defaults() {
+    for ratio in [1.15, 1.3] {
+        let (big, small) = (1.0, 1.0 / ratio);
+        let torus = liemesh::model::Formula(QuarticTorus { big, small });
+        let run = liemesh::run::<f64, _>(&torus, &MeshParams::at([big - small, 0.0, 0.0])).unwrap();
+        let v = &run.validation;
+        assert!(
+            v.is_closed() && v.euler_characteristic == 0,
+            "R/a = {ratio}: {v}"
+        );
+        assert!(run.cut_short().is_empty(), "{:?}", run.cut_short());
+    }
+}

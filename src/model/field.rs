@@ -52,10 +52,17 @@ pub trait NormalField<T: Scalar>: Sync {
     /// (an ellipsoid's longest semi-axis, a hyperboloid's or a cylinder's widest waist):
     /// the automatic terminal conditions then reach at least that far, where the shape at
     /// `p0` alone could not tell (the flat side of a long ellipsoid looks like a cylinder).
-    /// The default, `None`, leaves them to the shape at `p0` ([`crate::Scales`]).
+    ///
+    /// The default estimates it from the centres of curvature at `p0` on an integrable field
+    /// ([`crate::Scales::centres_reach`]: a torus meshed from its inner equator reaches out
+    /// round its tube's centre), and otherwise returns `None`, which leaves the terminal
+    /// conditions to the shape at `p0` ([`crate::Scales`]).
     fn size_through(&self, p0: [f64; 3]) -> Option<f64> {
-        let _ = p0;
-        None
+        let shape = crate::model::LocalShape::at::<T, Self>(self, p0)?;
+        if !shape.is_integrable() {
+            return None;
+        }
+        crate::Scales::of(p0, &shape).centres_reach(p0, &shape)
     }
 
     /// The semi-axes of the surface through `p0`, shortest first, when the field knows it is
@@ -230,7 +237,9 @@ impl<T: Scalar> NormalField<T> for LieField<T> {
 
     /// For a quadric (`B = 0`, `A` symmetric: the level set `pᵀ A p = c` through `p0`), its
     /// largest semi-axis `√(c / λ)` over the eigenvalues `λ` of `A` of the sign of `c`, the
-    /// directions in which it is bounded. `None` for other fields and for a cone (`c = 0`).
+    /// directions in which it is bounded. `None` for other fields and for a cone (`c = 0`),
+    /// rather than the default's estimate from the centres of curvature: on an invariant's
+    /// own field, the shape at `p0` sizes the terminal conditions.
     fn size_through(&self, p0: [f64; 3]) -> Option<f64> {
         let (eigenvalues, c) = self.quadric_through(p0)?;
         let size = eigenvalues
