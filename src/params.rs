@@ -222,8 +222,9 @@ impl Default for MeshParams {
 ///   everywhere else).
 ///
 /// On a sphere of radius `r` both are `r`: the mesh is the same at every scale. A field that
-/// knows how far its surface reaches ([`NormalField::size_through`], a quadric) raises the
-/// extent to that ([`Scales::reaching`]).
+/// knows how far its surface reaches ([`NormalField::size_through`]: a quadric's semi-axes,
+/// or, for a field of one's own, its farthest centre of curvature at `p0`,
+/// [`Scales::centres_reach`]) raises the extent to that ([`Scales::reaching`]).
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct Scales {
@@ -252,13 +253,13 @@ impl Scales {
         Scales { extent, step }
     }
 
-    /// The farthest from the origin of the centres of curvature at `p0` (`p0 − n/κ` for each
-    /// principal curvature `κ`) that lie within 16 extents of it, if one is farther than the
-    /// extent: a surface reaches about that far round its centres of curvature (the default
-    /// of [`NormalField::size_through`]). A torus meshed from its inner equator is near the origin, yet bends round
-    /// its tube's centre, as far out as the ring (`R` against `R − a`): with the extent of
-    /// `p0` alone, the bounding box cut a fat torus's outer half off. Farther centres (a
-    /// nearly flat direction) tell nothing.
+    /// The distance from the origin of the farthest centre of curvature at `p0` (`p0 − n/κ`
+    /// for each principal curvature `κ`) among those no farther than 16 extents, if it is
+    /// farther than the extent (the default of [`NormalField::size_through`]): a surface
+    /// reaches about that far round its centres of curvature. A torus meshed from its inner
+    /// equator is near the origin, yet bends round its tube's centre, as far out as the ring
+    /// (`R` against `R − a`): with the extent of `p0` alone, the bounding box cut a fat
+    /// torus's outer half off. Farther centres (a nearly flat direction) tell nothing.
     pub fn centres_reach(&self, p0: [f64; 3], shape: &LocalShape) -> Option<f64> {
         let n = shape.normal;
         shape
