@@ -27,10 +27,24 @@ pub enum MeshError {
         /// The field's normal at `p0`.
         normal: [f64; 3],
     },
-    /// `v(p0)` is zero or not finite, so `p0` has no tangent plane.
+    /// `v(p0)` is finite and not zero, but so long or so short that its squared length is not
+    /// a normal `f64` number: its direction cannot be worked out in `f64` geometry.
     #[error(
-        "the normal field vanishes (or is not finite) at p0 = {p0:?}: {normal:?}; \
-         p0 is a singular point, choose another initial point"
+        "the normal field at p0 = {p0:?} is {normal:?}, too long or too short for f64 geometry \
+         (its squared length leaves the normal f64 range); only its direction matters: divide \
+         the field by a constant that brings its length near 1"
+    )]
+    FieldMagnitude {
+        /// The initial point.
+        p0: [f64; 3],
+        /// The field value there.
+        normal: [f64; 3],
+    },
+    /// `v(p0)` is zero or not finite (or its derivative is not), so `p0` has no tangent
+    /// plane or no curvature.
+    #[error(
+        "the normal field vanishes, or it or its derivative is not finite, at p0 = {p0:?} \
+         (the field there: {normal:?}); p0 is a singular point, choose another initial point"
     )]
     SingularInitialPoint {
         /// The initial point.
@@ -122,4 +136,19 @@ pub enum MeshError {
         /// Whether the field is not integrable at `p0` (the surface is swept, and may fold).
         swept: bool,
     },
+}
+
+impl MeshError {
+    /// The error for a `p0` where the field, `normal`, gives no unit normal or no shape in
+    /// `f64`: [`MeshError::FieldMagnitude`] when it is finite and not zero but its squared
+    /// length is not a normal number, [`MeshError::SingularInitialPoint`] otherwise.
+    pub(crate) fn no_normal_at(p0: [f64; 3], normal: [f64; 3]) -> MeshError {
+        let finite = normal.iter().all(|x| x.is_finite());
+        let squared: f64 = normal.iter().map(|x| x * x).sum();
+        if finite && normal.iter().any(|&x| x != 0.0) && !squared.is_normal() {
+            MeshError::FieldMagnitude { p0, normal }
+        } else {
+            MeshError::SingularInitialPoint { p0, normal }
+        }
+    }
 }

@@ -379,10 +379,7 @@ impl MeshParams {
             let v = field
                 .normal(&crate::scalar::Vec3::from_f64(self.p0))
                 .to_f64();
-            return Err(MeshError::SingularInitialPoint {
-                p0: self.p0,
-                normal: v,
-            });
+            return Err(MeshError::no_normal_at(self.p0, v));
         };
         let scales = Scales::of(self.p0, &shape).reaching(field.size_through(self.p0));
         // Beyond these sizes products of squared lengths leave f64's normal range (1e-80

@@ -134,3 +134,24 @@ fn small_budgets_end_the_run_without_error() {
         assert!(v.iter().all(|x| x.is_finite()));
     }
 }
+
+/// A field finite and not zero at `p0` but too long or too short for `f64` geometry (found by
+/// trying user fields scaled by 1e300 and 1e-300: the error said the field vanished, or was not
+/// finite, and to choose another `p0`). The error now names the remedy; a field scaled within
+/// range meshes as the unscaled one (only its direction matters).
+#[test]
+fn a_field_too_long_or_too_short_for_f64_says_to_rescale_it() {
+    let sphere = |k: f64| {
+        let inv = Invariant::from_numbers(&[k, k, k, 0.0, 0.0, 0.0]).unwrap();
+        generate(&LieField::<f64>::new(&inv), &Preset::Fig3.params())
+    };
+    for k in [1e300, 1e-300] {
+        let e = sphere(k).unwrap_err();
+        assert!(matches!(e, MeshError::FieldMagnitude { .. }), "{k}: {e}");
+        assert!(e.to_string().contains("divide the field"), "{e}");
+    }
+    let unit = sphere(1.0).unwrap().triangles.len();
+    for k in [1e100, 1e-100] {
+        assert_eq!(sphere(k).unwrap().triangles.len(), unit, "scaled by {k}");
+    }
+}

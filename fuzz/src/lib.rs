@@ -392,7 +392,8 @@ pub fn mesher(data: &[u8]) -> Result<(), Violation> {
 /// - parameters that do not resolve on `field` give exactly the error
 ///   [`MeshParams::resolve`] gives; ones that resolve give a mesh, with those resolved
 ///   parameters, or one of the errors that depend on the field's course
-///   ([`MeshError::SingularInitialPoint`], [`MeshError::DirectionParallelToNormal`],
+///   ([`MeshError::SingularInitialPoint`], [`MeshError::FieldMagnitude`],
+///   [`MeshError::DirectionParallelToNormal`],
 ///   [`MeshError::Triangulation`], [`MeshError::Empty`]), never [`MeshError::Invalid`];
 /// - the samples satisfy [`check_samples`] (budgets, step band, bookkeeping);
 /// - the chart triangulation satisfies [`check_chart`];
@@ -434,6 +435,7 @@ pub fn check_run(
                 matches!(
                     e,
                     MeshError::SingularInitialPoint { .. }
+                        | MeshError::FieldMagnitude { .. }
                         | MeshError::DirectionParallelToNormal { .. }
                         | MeshError::Triangulation(_)
                         | MeshError::Empty { .. }

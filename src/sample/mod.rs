@@ -277,10 +277,7 @@ pub(crate) fn sample_resolved<T: Scalar, F: NormalField<T>>(
     let p0 = Vec3::<T>::from_f64(params.p0);
     let v0 = field.normal(&p0);
     let Some((n0, _)) = v0.normalize() else {
-        return Err(MeshError::SingularInitialPoint {
-            p0: params.p0,
-            normal: v0.to_f64(),
-        });
+        return Err(MeshError::no_normal_at(params.p0, v0.to_f64()));
     };
     let w00 = Vec3::<T>::from_f64(params.w00);
     let Some(e1) = trace::project_tangent(&w00, &n0) else {
