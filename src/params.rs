@@ -7,6 +7,7 @@
 //! meshes the same way at any scale. Angles are [`Angle`]s, read and written in degrees.
 
 use crate::error::MeshError;
+use crate::geom::vec3::dot as dot3;
 use crate::model::{least_aligned_tangent, LocalShape, NormalField};
 use crate::scalar::Scalar;
 
@@ -267,11 +268,11 @@ impl Scales {
             .iter()
             .filter(|k| k.is_finite() && **k != 0.0)
             .map(|k| {
-                let c = [0, 1, 2].map(|i| p0[i] - n[i] / k);
-                (c[0] * c[0] + c[1] * c[1] + c[2] * c[2]).sqrt()
+                let centre = [0, 1, 2].map(|i| p0[i] - n[i] / k);
+                dot3(centre, centre).sqrt()
             })
             .filter(|d| d.is_finite() && *d <= CENTRE_REACH * self.extent)
-            .fold(None, |m: Option<f64>, d| Some(m.map_or(d, |m| m.max(d))))
+            .max_by(f64::total_cmp)
             .filter(|&d| d > self.extent)
     }
 

@@ -853,12 +853,11 @@ fn by_sectors(p: &[[f64; 2]]) -> Option<Filing> {
     let m = p.len();
     let (start, edges) = file_edges(m, m, |i| {
         let (a, b) = (p[i], p[(i + 1) % m]);
-        let (Some(ka), Some(kb)) = (sector(m, a), sector(m, b)) else {
+        let (ka, kb) = match (sector(m, a), sector(m, b)) {
+            (Some(ka), Some(kb)) => (ka, kb),
             // An end at the origin: the edge lies along the other end's direction.
-            return match sector(m, a).or(sector(m, b)) {
-                Some(k) => wrapped(m, k, k),
-                None => [None, None],
-            };
+            (Some(k), None) | (None, Some(k)) => return wrapped(m, k, k),
+            (None, None) => return [None, None],
         };
         let (turn, along) = (cross2(a, b), a[0] * b[0] + a[1] * b[1]);
         if turn == 0.0 && along < 0.0 {
