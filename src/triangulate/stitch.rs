@@ -17,6 +17,14 @@
 //! - it meets no existing triangle other than along the edges and corners it shares with them
 //!   (an exact test).
 //!
+//! Before the front advances, each hole between fronts that met (no vertex of its loop ended a
+//! curve on a terminal condition) of more than [`SMALL_HOLE`] edges, on an integrable field, is
+//! offered to a chart of its own (below): the loop's constrained Delaunay triangulation alone
+//! (a slit where converging curves ended side by side), else refined with new points (a far
+//! cap), each patch going in only if its triangles keep [`MIN_ANGLE_DEG`] but at the loop's own
+//! corners. A sphere's far cap traced from a pole closes so, at a fraction of the front's cost;
+//! what no chart fits (bands, seams, twisted holes) is left to the front.
+//!
 //! Candidates that glue edges — whose new edges are already boundary edges the other way round,
 //! as when a gap is zipped shut or a hole's last triangle goes in — go first; among equals the
 //! best-shaped. Each round runs twice over the front: first only triangles with no angle below
@@ -373,11 +381,24 @@ const CHART_HOLE: usize = 600;
 /// within this many degrees of the hole's mean normal (the surface there is a graph over the
 /// chart's plane).
 const CHART_TURN_DEG: f64 = 70.0;
+/// How a hole's chart is triangulated (see [`Stitcher::fill_by_chart`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Patch {
+    /// Refined by spade to [`CHART_ANGLE_DEG`], with new points inside the hole.
+    Refined,
+    /// The loop's constrained Delaunay triangulation alone, no new point: a slit between two
+    /// fronts that ended side by side is zipped so, where refinement would crowd points into
+    /// it.
+    Plain,
+}
+
 /// Times a hole that its chart could not fill is opened one ring wider and tried again.
 const CHART_ATTEMPTS: usize = 4;
 /// Most chords a new point of a hole's chart is reached by (each at most the loop's mean
 /// edge length).
 const CHART_HOPS: usize = 64;
+/// A hole's chart positions are multiples of this many of its mean edge length (2⁻²⁴).
+const CHART_SNAP: f64 = 1.0 / (1u32 << 24) as f64;
 /// Smallest angle spade's refinement aims for inside a hole's chart, degrees.
 const CHART_ANGLE_DEG: f64 = 25.0;
 
@@ -476,6 +497,25 @@ pub(crate) fn stitch<T: Scalar, F: NormalField<T>>(
     // holes that were opened, later).
     let mut opened: Option<HashSet<u32, FastHash>> = None;
     let mut best: Option<Snapshot<T>> = None;
+    // Holes between fronts that met which a chart of their own fills (a sphere's far cap, a
+    // slit where converging curves ended side by side) are filled first: the advancing front
+    // is left only what no chart fits. The patches are held to the front's smallest angle;
+    // small holes are the front's own (its scored triangles close them as cheaply).
+    if s.growth.new_points {
+        let floor = MIN_ANGLE_DEG.to_radians();
+        for ring in s.open_loops(CHART_HOLE) {
+            if ring.len() <= SMALL_HOLE {
+                continue;
+            }
+            let filled = s
+                .fill_by_chart(&ring, Patch::Plain, floor)
+                .or_else(|| s.fill_by_chart(&ring, Patch::Refined, floor));
+            if let Some((triangles, vertices)) = filled {
+                out.added += triangles;
+                out.vertices += vertices;
+            }
+        }
+    }
     for round in 0..=REDO_ROUNDS {
         // (Each free vertex takes about two triangles to take in.)
         let budget = 8 * (s.boundary_edges() + 2 * s.free_left()) + 64;
@@ -1749,7 +1789,7 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
         for attempt in 0..=CHART_ATTEMPTS {
             let mut failed = Vec::new();
             for ring in self.open_loops(CHART_HOLE) {
-                match self.fill_by_chart(&ring) {
+                match self.fill_by_chart(&ring, Patch::Refined, 0.0) {
                     Some((triangles, vertices)) => {
                         added += triangles;
                         out.vertices += vertices;
@@ -1790,12 +1830,15 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
     /// Fills the hole bounded by `ring` (a boundary loop, the hole on the right of each edge)
     /// through a chart of its own: the loop is projected onto the plane across its corners'
     /// mean field normal, triangulated there by spade (the loop's edges as constraints, kept
-    /// whole, refined to [`CHART_ANGLE_DEG`] with triangles about the loop's edge length),
-    /// and each new point is put on the surface by a chord from the nearest corner. The patch
+    /// whole; with [`Patch::Refined`], refined to [`CHART_ANGLE_DEG`] with triangles about
+    /// the loop's edge length), and each new point is put on the surface by a chord from the nearest corner. The patch
     /// goes in only if every corner and new point faces within [`CHART_TURN_DEG`] of the
     /// plane's normal, every triangle keeps its orientation once lifted, faces the field and
-    /// meets no triangle already there (exact test). Returns the triangles and vertices added.
-    fn fill_by_chart(&mut self, ring: &[u32]) -> Option<(usize, usize)> {
+    /// meets no triangle already there (exact test), and, with a `floor` above zero
+    /// (radians), every angle of its triangles is at least that, but where two of the loop's
+    /// edges meet in one triangle (the loop's own angle there). Returns the triangles and
+    /// vertices added.
+    fn fill_by_chart(&mut self, ring: &[u32], patch: Patch, floor: f64) -> Option<(usize, usize)> {
         use spade::{AngleLimit, RefinementParameters};
         let m = ring.len();
         if m < 3 || self.pos.len() + 4 * m + 64 > self.growth.max_vertices {
@@ -1824,17 +1867,31 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
         // Counter-clockwise in the chart is counter-clockwise about the normal, the mesh's
         // orientation.
         let (e1, e2) = tangent_frame(n);
+        let ids: Vec<u32> = ring.iter().rev().copied().collect();
+        // Each corner's place on the loop.
+        let position: HashMap<u32, usize, FastHash> =
+            ids.iter().enumerate().map(|(i, &v)| (v, i)).collect();
+        let mean_edge = (0..m)
+            .map(|i| {
+                dist(
+                    self.pos[ids[i] as usize],
+                    self.pos[ids[(i + 1) % m] as usize],
+                )
+            })
+            .sum::<f64>()
+            / m as f64;
+        // Chart positions are snapped to multiples of 2⁻²⁴ edge lengths, so that corners
+        // whose positions differ only by rounding (the same run in another working
+        // precision) give spade the same input, and symmetric corners (a far cap traced from
+        // a pole, nearly on one circle) the same triangulation.
+        let quantum = mean_edge * CHART_SNAP;
+        let snap = |x: f64| (x / quantum).round() * quantum;
         let chart = |q: [f64; 3]| {
             let d = sub(q, centre);
-            [dot(d, e1), dot(d, e2)]
+            [snap(dot(d, e1)), snap(dot(d, e2))]
         };
         // The hole runs counter-clockwise once the loop is reversed.
-        let corners2: Vec<[f64; 2]> = ring
-            .iter()
-            .rev()
-            .map(|&v| chart(self.pos[v as usize]))
-            .collect();
-        let ids: Vec<u32> = ring.iter().rev().copied().collect();
+        let corners2: Vec<[f64; 2]> = ids.iter().map(|&v| chart(self.pos[v as usize])).collect();
         let area: f64 = (0..m)
             .map(|i| {
                 let (p, q) = (corners2[i], corners2[(i + 1) % m]);
@@ -1845,15 +1902,6 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
         if area.is_nan() || area <= 0.0 || !simple_polygon(&corners2) {
             return None;
         }
-        let mean_edge = (0..m)
-            .map(|i| {
-                dist(
-                    self.pos[ids[i] as usize],
-                    self.pos[ids[(i + 1) % m] as usize],
-                )
-            })
-            .sum::<f64>()
-            / m as f64;
         // A frame of four far corners keeps the hole off the convex hull, whose edges the
         // refinement may split.
         let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
@@ -1863,7 +1911,7 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
                 hi[k] = hi[k].max(c[k]);
             }
         }
-        let pad = (hi[0] - lo[0]).max(hi[1] - lo[1]) + mean_edge;
+        let pad = snap((hi[0] - lo[0]).max(hi[1] - lo[1]) + mean_edge);
         let mut cdt: ConstrainedDelaunayTriangulation<Point2<f64>> = Default::default();
         for (x, y) in [
             (lo[0] - pad, lo[1] - pad),
@@ -1897,7 +1945,10 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
                 .with_angle_limit(AngleLimit::from_deg(CHART_ANGLE_DEG))
                 .with_max_allowed_area(1.5 * equilateral)
                 .with_min_required_area(0.05 * equilateral)
-                .with_max_additional_vertices(8 * m + 64),
+                .with_max_additional_vertices(match patch {
+                    Patch::Refined => 8 * m + 64,
+                    Patch::Plain => 0,
+                }),
         );
         // The loop's edges must have stayed whole: the patch is glued to them.
         if (0..m).any(|i| {
@@ -1957,10 +2008,26 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
             .iter()
             .map(|f| f.map(|i| index.get(&i).copied().unwrap_or(u32::MAX)))
             .collect();
+        let loop_edge = |u: u32, v: u32| {
+            let (i, j) = (position[&u], position[&v]);
+            (i + 1) % m == j || (j + 1) % m == i
+        };
+        let shapely = |t: [u32; 3]| {
+            let a = angles(corners(&self.pos, t));
+            (0..3).all(|k| {
+                let (v, before, after) = (t[k], t[(k + 2) % 3], t[(k + 1) % 3]);
+                a[k] >= floor
+                    || [before, after, v].iter().all(|w| position.contains_key(w))
+                        && loop_edge(v, before)
+                        && loop_edge(v, after)
+            })
+        };
         let fits = lifted_ok
-            && triangles
-                .iter()
-                .all(|&t| !t.contains(&u32::MAX) && self.patch_triangle_fits(t, n, centre, e1, e2));
+            && triangles.iter().all(|&t| {
+                !t.contains(&u32::MAX)
+                    && (floor <= 0.0 || shapely(t))
+                    && self.patch_triangle_fits(t, n, centre, e1, e2)
+            });
         if !fits {
             while self.pos.len() > first_new as usize {
                 self.retract();
