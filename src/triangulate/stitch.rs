@@ -1868,9 +1868,6 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
         // orientation.
         let (e1, e2) = tangent_frame(n);
         let ids: Vec<u32> = ring.iter().rev().copied().collect();
-        // Each corner's place on the loop.
-        let position: HashMap<u32, usize, FastHash> =
-            ids.iter().enumerate().map(|(i, &v)| (v, i)).collect();
         let mean_edge = (0..m)
             .map(|i| {
                 dist(
@@ -2008,24 +2005,23 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
             .iter()
             .map(|f| f.map(|i| index.get(&i).copied().unwrap_or(u32::MAX)))
             .collect();
-        let loop_edge = |u: u32, v: u32| {
-            let (i, j) = (position[&u], position[&v]);
-            (i + 1) % m == j || (j + 1) % m == i
+        // Whether chart vertices `p` and `q` are neighbours on the loop (its corners are the
+        // chart vertices `4..4 + m`, in order).
+        let loop_edge = |p: usize, q: usize| {
+            let corner = |x: usize| (4..4 + m).contains(&x).then(|| x - 4);
+            matches!((corner(p), corner(q)),
+                (Some(i), Some(j)) if (i + 1) % m == j || (j + 1) % m == i)
         };
-        let shapely = |t: [u32; 3]| {
+        let shapely = |f: [usize; 3], t: [u32; 3]| {
             let a = angles(corners(&self.pos, t));
             (0..3).all(|k| {
-                let (v, before, after) = (t[k], t[(k + 2) % 3], t[(k + 1) % 3]);
-                a[k] >= floor
-                    || [before, after, v].iter().all(|w| position.contains_key(w))
-                        && loop_edge(v, before)
-                        && loop_edge(v, after)
+                a[k] >= floor || loop_edge(f[k], f[(k + 2) % 3]) && loop_edge(f[k], f[(k + 1) % 3])
             })
         };
         let fits = lifted_ok
-            && triangles.iter().all(|&t| {
+            && faces.iter().zip(&triangles).all(|(&f, &t)| {
                 !t.contains(&u32::MAX)
-                    && (floor <= 0.0 || shapely(t))
+                    && (floor <= 0.0 || shapely(f, t))
                     && self.patch_triangle_fits(t, n, centre, e1, e2)
             });
         if !fits {
