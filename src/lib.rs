@@ -225,7 +225,9 @@ pub fn run_observed<T: Scalar, F: NormalField<T>>(
     let (points, curves) = (samples.points.len(), samples.curves.len());
     observe(Progress::at(Stage::Triangulating, points, curves, 0));
     let improve = params.mode == Mode::Default;
-    let (mut mesh, chart) = triangulate::triangulate(&samples, params.close, improve)?;
+    // A mesh that is stitched is flipped to surface Delaunay once it is whole, not as a chart.
+    let (mut mesh, chart) =
+        triangulate::triangulate(&samples, params.close, improve && !params.close)?;
     // The mesh's vertices in the working precision, found by provenance.
     let mut vertices = triangulate::sample_vertices(&samples, &mesh);
     let stitched = if params.close {
@@ -235,7 +237,11 @@ pub fn run_observed<T: Scalar, F: NormalField<T>>(
             curves,
             mesh.triangles.len(),
         ));
-        triangulate::stitch(field, params, &samples, &mut mesh, &mut vertices)
+        let stitched = triangulate::stitch(field, params, &samples, &mut mesh, &mut vertices);
+        if improve {
+            triangulate::flip_to_surface_delaunay(&mut mesh);
+        }
+        stitched
     } else {
         Default::default()
     };

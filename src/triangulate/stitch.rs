@@ -19,10 +19,10 @@
 //!
 //! Before the front advances, each hole between fronts that met (no vertex of its loop ended a
 //! curve on a terminal condition) of more than [`SMALL_HOLE`] edges, on an integrable field, is
-//! offered to a chart of its own (below): the loop's constrained Delaunay triangulation alone
-//! (a slit where converging curves ended side by side), else refined with new points (a far
-//! cap), each patch going in only if its triangles keep [`MIN_ANGLE_DEG`] but at the loop's own
-//! corners. A sphere's far cap traced from a pole closes so, at a fraction of the front's cost;
+//! offered to a chart of its own (below): refined with new points at the mesh's spacing around
+//! it (a far cap), else the loop's constrained Delaunay triangulation alone (a slit where
+//! converging curves ended side by side), each patch going in only if its triangles keep
+//! [`MIN_ANGLE_DEG`] but at the loop's own corners. A sphere's far cap traced from a pole closes so, at a fraction of the front's cost;
 //! what no chart fits (bands, seams, twisted holes) is left to the front.
 //!
 //! Candidates that glue edges — whose new edges are already boundary edges the other way round,
@@ -200,6 +200,16 @@ impl EdgeSet {
             self.added.resize(u + 1, Vec::new());
         }
         self.added[u].push(v);
+    }
+
+    /// The targets of the edges from `u`.
+    fn from(&self, u: u32) -> impl Iterator<Item = u32> + '_ {
+        let added = self.added.get(u as usize).map_or(&[][..], |l| &l[..]);
+        self.chart_row(u)
+            .iter()
+            .chain(added)
+            .copied()
+            .filter(|&t| t != GONE)
     }
 
     /// Whether some edge leaves `u` (whether `u` is on a triangle).
@@ -507,9 +517,12 @@ pub(crate) fn stitch<T: Scalar, F: NormalField<T>>(
             if ring.len() <= SMALL_HOLE {
                 continue;
             }
+            // (Left unrefined, or refined at its loop's edge length, which is twice the mesh's
+            // where curve ends lie far apart, fig3's far cap came out coarse: its largest
+            // face-normal error 3.3° against 2.5°.)
             let filled = s
-                .fill_by_chart(&ring, Patch::Plain, floor)
-                .or_else(|| s.fill_by_chart(&ring, Patch::Refined, floor));
+                .fill_by_chart(&ring, Patch::Refined, floor)
+                .or_else(|| s.fill_by_chart(&ring, Patch::Plain, floor));
             if let Some((triangles, vertices)) = filled {
                 out.added += triangles;
                 out.vertices += vertices;
@@ -1831,7 +1844,8 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
     /// through a chart of its own: the loop is projected onto the plane across its corners'
     /// mean field normal, triangulated there by spade (the loop's edges as constraints, kept
     /// whole; with [`Patch::Refined`], refined to [`CHART_ANGLE_DEG`] with triangles about
-    /// the loop's edge length), and each new point is put on the surface by a chord from the nearest corner. The patch
+    /// as large as those around the loop, or its edges if shorter: see
+    /// [`Self::spacing_into`]), and each new point is put on the surface by a chord from the nearest corner. The patch
     /// goes in only if every corner and new point faces within [`CHART_TURN_DEG`] of the
     /// plane's normal, every triangle keeps its orientation once lifted, faces the field and
     /// meets no triangle already there (exact test), and, with a `floor` above zero
@@ -1877,15 +1891,15 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
             })
             .sum::<f64>()
             / m as f64;
-        // Chart positions are snapped to multiples of 2⁻²⁴ edge lengths, so that corners
-        // whose positions differ only by rounding (the same run in another working
-        // precision) give spade the same input, and symmetric corners (a far cap traced from
-        // a pole, nearly on one circle) the same triangulation.
-        let quantum = mean_edge * CHART_SNAP;
-        let snap = |x: f64| (x / quantum).round() * quantum;
+        // Chart positions are in mean edge lengths (spade refuses coordinates below 10⁻⁴³ or
+        // so: a sphere of radius 10⁻⁵⁰ would lose its patches), snapped to multiples of 2⁻²⁴,
+        // so that corners whose positions differ only by rounding (the same run in another
+        // working precision) give spade the same input, and symmetric corners (a far cap
+        // traced from a pole, nearly on one circle) the same triangulation.
+        let snap = |x: f64| (x / CHART_SNAP).round() * CHART_SNAP;
         let chart = |q: [f64; 3]| {
             let d = sub(q, centre);
-            [snap(dot(d, e1)), snap(dot(d, e2))]
+            [snap(dot(d, e1) / mean_edge), snap(dot(d, e2) / mean_edge)]
         };
         // The hole runs counter-clockwise once the loop is reversed.
         let corners2: Vec<[f64; 2]> = ids.iter().map(|&v| chart(self.pos[v as usize])).collect();
@@ -1908,7 +1922,7 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
                 hi[k] = hi[k].max(c[k]);
             }
         }
-        let pad = snap((hi[0] - lo[0]).max(hi[1] - lo[1]) + mean_edge);
+        let pad = snap((hi[0] - lo[0]).max(hi[1] - lo[1]) + 1.0);
         let mut cdt: ConstrainedDelaunayTriangulation<Point2<f64>> = Default::default();
         for (x, y) in [
             (lo[0] - pad, lo[1] - pad),
@@ -1934,7 +1948,12 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
             }
             cdt.add_constraint(a, b);
         }
-        let equilateral = 0.25 * 3f64.sqrt() * mean_edge * mean_edge;
+        // Triangles about the size of the mesh's around the loop: the loop's edges between
+        // curves that ended far apart can be twice as long as the edges into the mesh.
+        let spacing = self
+            .spacing_into(ring)
+            .map_or(1.0, |h| (h / mean_edge).min(1.0));
+        let equilateral = 0.25 * 3f64.sqrt() * spacing * spacing;
         let result = cdt.refine(
             RefinementParameters::new()
                 .exclude_outer_faces(true)
@@ -1992,7 +2011,7 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
             let p2 = cdt
                 .vertex(spade::handles::FixedVertexHandle::from_index(i))
                 .position();
-            let target = [0, 1, 2].map(|k| centre[k] + p2.x * e1[k] + p2.y * e2[k]);
+            let target = [0, 1, 2].map(|k| centre[k] + mean_edge * (p2.x * e1[k] + p2.y * e2[k]));
             let Some(point) = self.lift(ids.as_slice(), target, n, turn_cos, mean_edge) else {
                 lifted_ok = false;
                 break;
@@ -2038,6 +2057,28 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
             self.add(t);
         }
         Some((triangles.len(), self.pos.len() - first_new as usize))
+    }
+
+    /// The median length of the edges from the corners of `ring` (a boundary loop) into the
+    /// mesh, those that are not the loop's own; `None` if there are none.
+    fn spacing_into(&self, ring: &[u32]) -> Option<f64> {
+        let m = ring.len();
+        let mut lengths: Vec<f64> = Vec::new();
+        for (i, &v) in ring.iter().enumerate() {
+            let (before, after) = (ring[(i + m - 1) % m], ring[(i + 1) % m]);
+            lengths.extend(
+                self.edges
+                    .from(v)
+                    .filter(|&w| w != before && w != after)
+                    .map(|w| dist(self.pos[v as usize], self.pos[w as usize])),
+            );
+        }
+        lengths.retain(|l| l.is_finite() && *l > 0.0);
+        if lengths.is_empty() {
+            return None;
+        }
+        let mid = lengths.len() / 2;
+        Some(*lengths.select_nth_unstable_by(mid, f64::total_cmp).1)
     }
 
     /// The point of the surface over chart point `target` (a chord from the nearest of
