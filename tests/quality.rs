@@ -294,8 +294,10 @@ fn most_ellipsoids_close_from_any_starting_point() {
     // Axis-aligned ellipsoids with semi-axis ratios up to 4, each meshed from a random point
     // of it: from most starting points the curves cross a caustic on the far side, and the
     // closing has to fill the folded band. 16 of these 60 closed before folded triangles
-    // were filled together with the hole (all 60 now, every one with angles of at least 15°
-    // and face normals within 15° of the field); open meshes are reported, and valid.
+    // were filled together with the hole (all 60 now, every one with angles of at least 17°
+    // and face normals within 15° of the field); open meshes are reported, and valid. Since
+    // the stitched mesh is flipped before it is relaxed, their smallest angles average 27.2°
+    // and the lowest is 18.1° (21.5° and 15.7° before).
     let mut state = 12345_u64;
     let mut uniform = || {
         state ^= state << 13;
@@ -326,7 +328,7 @@ fn most_ellipsoids_close_from_any_starting_point() {
         if liemesh::quality::Topology::of(&run.mesh).closed {
             closed += 1;
             let q = QualityReport::measure(&inv, &params, &run.samples, &run.mesh);
-            assert!(q.shape.min_angle >= 15.0, "{}", q.shape.min_angle);
+            assert!(q.shape.min_angle >= 17.0, "{}", q.shape.min_angle);
             assert!(
                 q.face_normal_error_max <= 15.0,
                 "{}",
