@@ -154,7 +154,8 @@ impl<T> MeshRun<T> {
 pub struct Timings {
     /// Tracing the curves (sampling).
     pub sampling: f64,
-    /// The chart triangulation and stitching where fronts meet.
+    /// The chart triangulation, stitching where fronts meet and, in the default mode, the
+    /// flips to surface Delaunay.
     pub triangulating: f64,
     /// Relaxation and edge flips (default mode).
     pub improving: f64,
