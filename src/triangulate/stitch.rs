@@ -22,8 +22,15 @@
 //! offered to a chart of its own (below): refined with new points at the mesh's spacing around
 //! it (a far cap), else the loop's constrained Delaunay triangulation alone (a slit where
 //! converging curves ended side by side), each patch going in only if its triangles keep
-//! [`MIN_ANGLE_DEG`] but at the loop's own corners. A sphere's far cap traced from a pole closes so, at a fraction of the front's cost;
-//! what no chart fits (bands, seams, twisted holes) is left to the front.
+//! [`MIN_ANGLE_DEG`] but at the loop's own corners. A sphere's far cap traced from a pole
+//! closes so, at a fraction of the front's cost; what no chart fits (bands, seams, twisted
+//! holes) is left to the front. First, on such a field, islands go: components of at most
+//! [`ISLAND`] chart triangles with no vertex on a terminal boundary, left between dropped chart
+//! triangles where many curves converge, which would force slivers between them and the rest.
+//!
+//! A new point of the front is placed where the triangle on its edge would be equilateral,
+//! reached from the edge's first end by two half chords: where the potential is not cubic a
+//! chord's truncation error is of the fifth order in its length.
 //!
 //! Candidates that glue edges — whose new edges are already boundary edges the other way round,
 //! as when a gap is zipped shut or a hole's last triangle goes in — go first; among equals the
