@@ -2339,10 +2339,10 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
         }
         let mut size = vec![0usize; near.len()];
         let mut root_anchored = vec![false; near.len()];
-        for i in 0..near.len() {
+        for (i, &held) in anchored.iter().enumerate() {
             let r = sets.find(i as u32) as usize;
             size[r] += 1;
-            root_anchored[r] |= anchored[i];
+            root_anchored[r] |= held;
         }
         let doomed: Vec<u32> = near
             .iter()
