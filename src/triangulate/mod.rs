@@ -135,8 +135,6 @@ pub fn triangulate<T: Scalar>(
     ))
 }
 
-/// The working-precision points of the vertices of `mesh`, every one a sample (a mesh as
-/// [`triangulate`] makes it).
 /// Flips edges of `mesh` until it is Delaunay on the surface (at most 8 flips a triangle):
 /// the stitched mesh's turn of the flips that [`triangulate`] gives a chart mesh that is not
 /// stitched. The seams and patches the stitching adds are chosen one triangle at a time, and
@@ -154,6 +152,8 @@ pub(crate) fn flip_to_surface_delaunay(mesh: &mut Mesh) {
     );
 }
 
+/// The working-precision points of the vertices of `mesh`, every one a sample (a mesh as
+/// [`triangulate`] makes it).
 pub(crate) fn sample_vertices<T: Scalar>(samples: &Samples<T>, mesh: &Mesh) -> Vec<Vec3<T>> {
     mesh.provenance
         .iter()

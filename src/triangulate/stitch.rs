@@ -1869,8 +1869,8 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
     /// mean field normal, triangulated there by spade (the loop's edges as constraints, kept
     /// whole; with [`Patch::Refined`], refined to [`CHART_ANGLE_DEG`] with triangles about
     /// as large as those around the loop, or its edges if shorter: see
-    /// [`Self::spacing_into`]), and each new point is put on the surface by a chord from the nearest corner. The patch
-    /// goes in only if every corner and new point faces within [`CHART_TURN_DEG`] of the
+    /// [`Self::spacing_into`]), and each new point is put on the surface by a chord from the
+    /// nearest corner. The patch goes in only if every corner and new point faces within [`CHART_TURN_DEG`] of the
     /// plane's normal, every triangle keeps its orientation once lifted, faces the field and
     /// meets no triangle already there (exact test), and, with a `floor` above zero
     /// (radians), every angle of its triangles is at least that, but where two of the loop's
@@ -2106,8 +2106,8 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
     }
 
     /// The point of the surface over chart point `target` (a chord from the nearest of
-    /// `corners`, in the working precision, in hops of at most `hop_length`), with its unit field normal, if that normal is
-    /// within `turn_cos` of the chart's normal `n`.
+    /// `corners`, in the working precision, in hops of at most `hop_length`), with its unit
+    /// field normal, if that normal is within `turn_cos` of the chart's normal `n`.
     fn lift(
         &self,
         corners: &[u32],
