@@ -1847,13 +1847,24 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
     /// curve on a terminal condition: holes left where fronts met. Each loop once, in a
     /// deterministic order.
     fn open_loops(&self, limit: usize) -> Vec<Vec<u32>> {
+        let edges = self.boundary_edge_list();
+        let cycle = self.boundary_cycle_lengths(&edges);
         let mut seen: HashSet<u32, FastHash> = HashSet::default();
         let mut out = Vec::new();
-        for (a, b) in self.boundary_edge_list() {
+        for (a, b) in edges {
             if seen.contains(&a) {
                 continue;
             }
-            let Some(ring) = self.loop_from((a, b), limit) else {
+            // From a vertex with one boundary edge out, the walk is its cycle's, found
+            // already: only a cycle short enough is walked (walking every edge of a long
+            // loop up to `limit` steps made this quadratic in the boundary).
+            let ring = match cycle.get(&a) {
+                Some(&len) if len > limit + 1 => None,
+                Some(_) => self.loop_from((a, b), limit),
+                None if self.boundary.outs(a).len() == 1 => None,
+                None => self.loop_from((a, b), limit),
+            };
+            let Some(ring) = ring else {
                 continue;
             };
             seen.extend(ring.iter().copied());
@@ -2201,6 +2212,52 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
 
     /// The boundary loop through edge `start`, if it is a simple loop (no pinched vertex on
     /// it) of at most `limit` edges.
+    /// The length of the boundary cycle through each vertex that lies on one made only of
+    /// vertices with a single boundary edge out (the successor graph's cycles, each found
+    /// once). A vertex with one edge out that is on no such cycle has no entry; from it,
+    /// [`Self::loop_from`] fails, and from one on a cycle it returns that cycle.
+    fn boundary_cycle_lengths(&self, edges: &[(u32, u32)]) -> HashMap<u32, usize, FastHash> {
+        let next = |v: u32| match self.boundary.outs(v) {
+            [w] => Some(*w),
+            _ => None,
+        };
+        // 1: on the path being followed, 2: done.
+        let mut state: HashMap<u32, u8, FastHash> = HashMap::default();
+        let mut cycle: HashMap<u32, usize, FastHash> = HashMap::default();
+        let mut path = Vec::new();
+        for &(a, _) in edges {
+            if state.contains_key(&a) {
+                continue;
+            }
+            path.clear();
+            let mut v = a;
+            let end = loop {
+                match state.get(&v) {
+                    Some(_) => break Some(v),
+                    None => {
+                        state.insert(v, 1);
+                        path.push(v);
+                        match next(v) {
+                            Some(w) => v = w,
+                            None => break None,
+                        }
+                    }
+                }
+            };
+            if let Some(v) = end.filter(|v| state[v] == 1) {
+                let at = path.iter().position(|&x| x == v).expect("on the path");
+                let len = path.len() - at;
+                for &x in &path[at..] {
+                    cycle.insert(x, len);
+                }
+            }
+            for &x in &path {
+                state.insert(x, 2);
+            }
+        }
+        cycle
+    }
+
     fn loop_from(&self, (a, b): (u32, u32), limit: usize) -> Option<Vec<u32>> {
         if !self.is_boundary_edge(a, b) {
             return None;
