@@ -131,8 +131,8 @@ pub struct MeshParams {
     /// ellipsoid up to 16:1 ([`NormalField::semi_axes_through`]) also at most a quarter of
     /// `beta_min` times its sharpest bend's radius.
     pub dt_min: Option<f64>,
-    /// Largest step; automatic: half the step scale, and on an ellipsoid up to 16:1 at most
-    /// its shortest semi-axis.
+    /// Largest step; automatic: half the step scale, at most a twelfth of `max_radius`, and
+    /// on an ellipsoid up to 16:1 at most its shortest semi-axis.
     pub dt_max: Option<f64>,
     /// β_min: smallest normal turn per step.
     #[cfg_attr(feature = "serde", serde(rename = "beta_min_deg"))]
@@ -356,6 +356,12 @@ const AUTO_RADIUS: f64 = 4.0 * std::f64::consts::PI;
 /// itself within about this radius, and what lies beyond is laid only to be cut away.
 const AUTO_RADIUS_SWEPT: f64 = std::f64::consts::PI;
 const AUTO_BOX: f64 = 6.0;
+/// The automatic `dt_max` is at most the geodesic radius over this: a curve crosses the
+/// region it meshes in a dozen steps or more. Half the step scale alone can be as long as
+/// the region is wide where the surface is flat at `p0`: a Hamiltonian sweep with a radius
+/// of curvature of 14 at `p0`, 6.7 from the origin, took steps of 7 across a radius of 21
+/// and came out as 168 triangles (739 with this bound).
+const STEPS_ACROSS_RADIUS: f64 = 12.0;
 /// Centres of curvature up to this many extents (of the shape at `p0`) from the origin raise
 /// the extent ([`Scales::centres_reach`]).
 const CENTRE_REACH: f64 = 16.0;
@@ -411,6 +417,29 @@ impl MeshParams {
             .map_or((f64::INFINITY, f64::INFINITY), |[s0, _, s2]| {
                 (s0, s0 * s0 / s2)
             });
+        let max_radius = self.max_radius.unwrap_or(
+            if shape.is_integrable() {
+                AUTO_RADIUS
+            } else {
+                AUTO_RADIUS_SWEPT
+            } * scales.extent,
+        );
+        let dt_max = self.dt_max.unwrap_or(
+            (AUTO_DT_MAX * scales.step)
+                .min(thickness)
+                .min(max_radius / STEPS_ACROSS_RADIUS),
+        );
+        let dt_min = self.dt_min.unwrap_or_else(|| {
+            let auto = (AUTO_DT_MIN.min(0.25 * self.beta_min.radians()) * scales.step)
+                .min(0.25 * self.beta_min.radians() * sharpest);
+            // (Only a surface hundreds of times flatter at `p0` than its extent has the
+            // automatic dt_min above that bound.)
+            if self.dt_max.is_none() {
+                auto.min(dt_max)
+            } else {
+                auto
+            }
+        });
         let resolved = Resolved {
             given: self.clone(),
             scales,
@@ -422,20 +451,9 @@ impl MeshParams {
             dt: self
                 .dt
                 .unwrap_or(AUTO_DT.min(2.0 * self.beta_max.radians()) * scales.step),
-            dt_min: self.dt_min.unwrap_or(
-                (AUTO_DT_MIN.min(0.25 * self.beta_min.radians()) * scales.step)
-                    .min(0.25 * self.beta_min.radians() * sharpest),
-            ),
-            dt_max: self
-                .dt_max
-                .unwrap_or((AUTO_DT_MAX * scales.step).min(thickness)),
-            max_radius: self.max_radius.unwrap_or(
-                if shape.is_integrable() {
-                    AUTO_RADIUS
-                } else {
-                    AUTO_RADIUS_SWEPT
-                } * scales.extent,
-            ),
+            dt_min,
+            dt_max,
+            max_radius,
             bounding_box: self.bounding_box.unwrap_or(AUTO_BOX * scales.extent),
         };
         resolved.check_lengths()?;

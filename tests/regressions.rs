@@ -569,3 +569,42 @@ fn a_fat_torus_closes_from_its_inner_equator_with_defaults() {
         assert!(run.cut_short().is_empty(), "{:?}", run.cut_short());
     }
 }
+
+/// Found by `hamiltonian_invariants_sweep_an_embedded_surface` with another seed
+/// (`PROPTEST_RNG_SEED=2026`): the sheet is flat at `p0` (radius of curvature 14, `p0` 6.7
+/// from the origin), so the automatic dt_max, half that radius, was 7, and the curves crossed
+/// the sweep's radius of 21 in three steps: 20 curves, 168 triangles. The automatic dt_max is
+/// now at most a twelfth of the radius.
+#[test]
+fn a_sweep_flat_at_its_start_is_crossed_in_a_dozen_steps() {
+    let invariant = Invariant::from_numbers(&[
+        -0.6592062730511805,
+        0.02756725834532803,
+        0.8100341427108568,
+        0.11014414975732277,
+        0.44984618836347484,
+        -0.45983499534732447,
+        0.9111201697541128,
+        -0.3038337127054496,
+        0.03467281074708856,
+        -0.3897778650039483,
+        0.7773444283085565,
+        -0.7690112115031114,
+        0.02027923958346636,
+        -0.00018005733078082663,
+        -0.3786465553955463,
+        -0.30595221203634804,
+        -0.8887194674662813,
+        0.23788709289695825,
+    ])
+    .unwrap();
+    let field = LieField::<f64>::new(&invariant);
+    let params = MeshParams::at([-4.937384314892286, 4.52754309045508, 0.3543896701097629]);
+    let run = liemesh::run(&field, &params).unwrap();
+    let resolved = params.resolve::<f64, _>(&field).unwrap();
+    assert!(resolved.dt_max <= resolved.max_radius / 12.0, "{resolved:?}");
+    assert!(run.validation.is_valid(), "{}", run.validation);
+    // (Measured: 733 triangles.)
+    let triangles = run.mesh.triangles.len();
+    assert!(triangles >= 500, "{triangles} triangles");
+}
