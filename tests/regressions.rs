@@ -602,7 +602,10 @@ fn a_sweep_flat_at_its_start_is_crossed_in_a_dozen_steps() {
     let params = MeshParams::at([-4.937384314892286, 4.52754309045508, 0.3543896701097629]);
     let run = liemesh::run(&field, &params).unwrap();
     let resolved = params.resolve::<f64, _>(&field).unwrap();
-    assert!(resolved.dt_max <= resolved.max_radius / 12.0, "{resolved:?}");
+    assert!(
+        resolved.dt_max <= resolved.max_radius / 12.0,
+        "{resolved:?}"
+    );
     assert!(run.validation.is_valid(), "{}", run.validation);
     // (Measured: 733 triangles.)
     let triangles = run.mesh.triangles.len();
