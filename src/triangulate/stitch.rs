@@ -1881,12 +1881,12 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
     /// whole; with [`Patch::Refined`], refined to [`CHART_ANGLE_DEG`] with triangles about
     /// as large as those around the loop, or its edges if shorter: see
     /// [`Self::spacing_into`]), and each new point is put on the surface by a chord from the
-    /// nearest corner. The patch goes in only if every corner and new point faces within [`CHART_TURN_DEG`] of the
-    /// plane's normal, every triangle keeps its orientation once lifted, faces the field and
-    /// meets no triangle already there (exact test), and, with a `floor` above zero
-    /// (radians), every angle of its triangles is at least that, but where two of the loop's
-    /// edges meet in one triangle (the loop's own angle there). Returns the triangles and
-    /// vertices added.
+    /// nearest corner. The patch goes in only if every corner and new point faces within
+    /// [`CHART_TURN_DEG`] of the plane's normal, every triangle keeps its orientation once
+    /// lifted, faces the field and meets no triangle already there (exact test), and, with a
+    /// `floor` above zero (radians), every angle of its triangles is at least that, but where
+    /// two of the loop's edges meet in one triangle (the loop's own angle there). Returns the
+    /// triangles and vertices added.
     fn fill_by_chart(&mut self, ring: &[u32], patch: Patch, floor: f64) -> Option<(usize, usize)> {
         use spade::{AngleLimit, RefinementParameters};
         let m = ring.len();
@@ -2210,12 +2210,11 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
             .all(|&v| point_triangle_distance(self.pos[v as usize], c) > EAR_CLEARANCE * size)
     }
 
-    /// The boundary loop through edge `start`, if it is a simple loop (no pinched vertex on
-    /// it) of at most `limit` edges.
     /// The length of the boundary cycle through each vertex that lies on one made only of
     /// vertices with a single boundary edge out (the successor graph's cycles, each found
     /// once). A vertex with one edge out that is on no such cycle has no entry; from it,
-    /// [`Self::loop_from`] fails, and from one on a cycle it returns that cycle.
+    /// [`Self::loop_from`] fails, and from one on a cycle it returns that cycle if it is
+    /// short enough.
     fn boundary_cycle_lengths(&self, edges: &[(u32, u32)]) -> HashMap<u32, usize, FastHash> {
         let next = |v: u32| match self.boundary.outs(v) {
             [w] => Some(*w),
@@ -2258,6 +2257,8 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
         cycle
     }
 
+    /// The boundary loop through edge `a → b`, if it is a simple loop (no pinched vertex on
+    /// it) of at most `limit` edges.
     fn loop_from(&self, (a, b): (u32, u32), limit: usize) -> Option<Vec<u32>> {
         if !self.is_boundary_edge(a, b) {
             return None;
