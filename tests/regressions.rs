@@ -611,3 +611,47 @@ fn a_sweep_flat_at_its_start_is_crossed_in_a_dozen_steps() {
     let triangles = run.mesh.triangles.len();
     assert!(triangles >= 500, "{triangles} triangles");
 }
+
+/// A 12-number sweep from `p0` 0.002 from the origin, a singular point of every invariant's
+/// field, where the swept sheet's curvature grows without bound: the curves crawled round it
+/// in steps down to the integrable fields' clamp, a hundredth of Δt, and the run laid
+/// 507,766 samples on 39,595 curves for a 95,945-triangle mesh with 74 boundary loops, in
+/// 21 s. On a non-integrable field the automatic dt_min is now a tenth of Δt (measured:
+/// 21,163 samples, 1,475 curves, 12,872 triangles, 0.2 s).
+#[test]
+fn a_sweep_round_the_fields_singular_point_stops_at_a_tenth_of_the_step() {
+    let invariant = Invariant::from_numbers(&[
+        2.4807931380918884,
+        1.5278972500331085,
+        0.26047518100116307,
+        0.0,
+        0.0,
+        0.0,
+        0.5111117580242763,
+        0.1994936555875979,
+        0.35403729697479114,
+        -0.9499644041449509,
+        -0.6987454066121672,
+        -0.7773895850698254,
+    ])
+    .unwrap();
+    let field = LieField::<f64>::new(&invariant);
+    let params = MeshParams::at([
+        -0.001084511256912943,
+        0.0016399160344815942,
+        0.0009620290330742754,
+    ]);
+    let resolved = params.resolve::<f64, _>(&field).unwrap();
+    assert!(resolved.dt_min >= 0.099 * resolved.dt, "{resolved:?}");
+    let run = liemesh::run(&field, &params).unwrap();
+    assert!(run.validation.is_valid(), "{}", run.validation);
+    let (samples, curves, triangles) = (
+        run.samples.points.len(),
+        run.samples.curves.len(),
+        run.mesh.triangles.len(),
+    );
+    assert!(
+        samples < 100_000 && curves < 5_000 && triangles >= 500,
+        "{samples} samples, {curves} curves, {triangles} triangles"
+    );
+}
