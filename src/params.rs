@@ -127,8 +127,8 @@ pub struct MeshParams {
     /// step scales when that is smaller.
     pub dt: Option<f64>,
     /// Smallest step (steps are clamped to `[dt_min, dt_max]`); automatic: 10⁻³ step scales
-    /// (10⁻² on a non-integrable field, whose sheet may run into a singular point of the
-    /// field), or a quarter of `beta_min` (in radians) step scales when that is smaller; on an
+    /// (on a non-integrable field, whose sheet may run into a singular point of the field,
+    /// up to 10⁻² step scales but at most 4·10⁻³ extent scales), or a quarter of `beta_min` (in radians) step scales when that is smaller; on an
     /// ellipsoid up to 16:1 ([`NormalField::semi_axes_through`]) also at most a quarter of
     /// `beta_min` times its sharpest bend's radius.
     pub dt_min: Option<f64>,
@@ -346,13 +346,19 @@ pub(crate) const MAX_SURFACE_SIZE: f64 = 1e60;
 /// bounding_box (of the extent scale).
 const AUTO_DT: f64 = 0.1;
 const AUTO_DT_MIN: f64 = 1e-3;
-/// The automatic `dt_min` on a non-integrable field, of the step scale: a tenth of the
-/// automatic Δt. A swept sheet curved ten times more sharply than at `p0` is running into a
-/// singular point of the field (the origin, for an invariant's), where its curvature grows
-/// without bound; with the integrable fields' clamp, a hundredth of Δt, the curves crawled
-/// round it in steps that short: a random 18-number sweep from 0.04 off the origin laid
-/// 866,629 samples for 6,073 triangles in 35 s (2.7 s with this clamp).
+/// The automatic `dt_min` on a non-integrable field: a tenth of the automatic Δt (this, of
+/// the step scale), but not above [`SWEPT_DT_MIN_OF_EXTENT`] extents, and not below the
+/// integrable fields' clamp. The sweep's steps shrink in proportion to the distance to the
+/// field's singular point, which for an invariant (the origin) lies within an extent of
+/// `p0`; with the integrable fields' clamp, a hundredth of Δt, the curves crawled round it:
+/// a random 18-number sweep from 0.04 off the origin laid 866,629 samples for 6,073
+/// triangles in 35 s (2.7 s with this clamp). The cap by the extent keeps the old clamp where
+/// the sheet is flat at `p0` and its step scale several extents long (a twisted linear
+/// invariant 1.3 off the origin with a radius of curvature of 19.5 there kept 249
+/// triangles; a tenth of Δt left 159).
 const AUTO_DT_MIN_SWEPT: f64 = 1e-2;
+/// See [`AUTO_DT_MIN_SWEPT`].
+const SWEPT_DT_MIN_OF_EXTENT: f64 = 4e-3;
 const AUTO_DT_MAX: f64 = 0.5;
 /// The flattest ellipsoid (longest over shortest semi-axis) whose automatic step clamps are
 /// fitted to the whole surface (see [`MeshParams::resolve`]): measured, 1:1:0.071 (`λ` up to
@@ -439,13 +445,16 @@ impl MeshParams {
                 .min(max_radius / STEPS_ACROSS_RADIUS),
         );
         let dt_min = self.dt_min.unwrap_or_else(|| {
-            let floor = if shape.is_integrable() {
-                AUTO_DT_MIN
+            let quarter_band = 0.25 * self.beta_min.radians();
+            let clamp = (AUTO_DT_MIN.min(quarter_band) * scales.step).min(quarter_band * sharpest);
+            let auto = if shape.is_integrable() {
+                clamp
             } else {
-                AUTO_DT_MIN_SWEPT
+                clamp.max(
+                    (AUTO_DT_MIN_SWEPT.min(quarter_band) * scales.step)
+                        .min(SWEPT_DT_MIN_OF_EXTENT * scales.extent),
+                )
             };
-            let auto = (floor.min(0.25 * self.beta_min.radians()) * scales.step)
-                .min(0.25 * self.beta_min.radians() * sharpest);
             // (Only a surface hundreds of times flatter at `p0` than its extent has the
             // automatic dt_min above that bound.)
             if self.dt_max.is_none() {

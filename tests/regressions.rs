@@ -655,3 +655,30 @@ fn a_sweep_round_the_fields_singular_point_stops_at_a_tenth_of_the_step() {
         "{samples} samples, {curves} curves, {triangles} triangles"
     );
 }
+
+/// A twisted linear invariant (eq. 2 with angles) from `p0` 1.3 off the origin, where the
+/// swept sheet is flat (radius of curvature 19.5, step scale four extents): with a sweep's
+/// `dt_min` at a tenth of Δt it came out as 159 triangles, under the class test's 200
+/// (`PROPTEST_RNG_SEED=16016 PROPTEST_CASES=400`, `tests/classes.rs`). The sweeps' larger
+/// `dt_min` is capped by the extent, and here stays the integrable fields' clamp: 249
+/// triangles, as before it.
+#[test]
+fn a_sweep_flat_at_its_start_keeps_the_fine_step_clamp() {
+    let invariant = Invariant::from_numbers(&[
+        1.9263942477157772,
+        2.0489511362219512,
+        1.6729894014163398,
+        0.8760698455321804,
+        -0.9392502667498955,
+        -0.635198425015299,
+    ])
+    .unwrap();
+    let field = LieField::<f64>::new(&invariant);
+    let params = MeshParams::at([0.8648580165984566, -0.7526201224277017, -0.6973756600948774]);
+    let resolved = params.resolve::<f64, _>(&field).unwrap();
+    assert!(resolved.dt_min <= 0.011 * resolved.dt, "{resolved:?}");
+    let run = liemesh::run(&field, &params).unwrap();
+    assert!(run.validation.is_valid(), "{}", run.validation);
+    let triangles = run.mesh.triangles.len();
+    assert!(triangles >= 200, "{triangles} triangles");
+}
