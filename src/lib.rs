@@ -126,11 +126,13 @@ impl<T> MeshRun<T> {
         if ends.budget > 0 && !self.samples.hit_point_budget {
             why.push(format!(
                 "{} curve{} ended on a budget (max_steps = {} steps per curve, or no chord \
-                 within max_retries = {} Newton iterations)",
+                 within max_retries = {} Newton iterations at any step down to dt_min = {:.3e}, \
+                 where the surface bends more sharply than that step can follow)",
                 ends.budget,
                 if ends.budget == 1 { "" } else { "s" },
                 p.max_steps,
-                p.max_retries
+                p.max_retries,
+                p.dt_min
             ));
         }
         if self.stitched.budget_hit {
