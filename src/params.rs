@@ -126,11 +126,12 @@ pub struct MeshParams {
     /// Initial step Δt; automatic: a tenth of the step scale, or twice `beta_max` (in radians)
     /// step scales when that is smaller.
     pub dt: Option<f64>,
-    /// Smallest step (steps are clamped to `[dt_min, dt_max]`); automatic: 10⁻³ step scales
-    /// (on a non-integrable field, whose sheet may run into a singular point of the field,
-    /// up to 10⁻² step scales but at most 4·10⁻³ extent scales), or a quarter of `beta_min` (in radians) step scales when that is smaller; on an
+    /// Smallest step (steps are clamped to `[dt_min, dt_max]`); automatic: 10⁻³ step scales,
+    /// or a quarter of `beta_min` (in radians) step scales when that is smaller; on an
     /// ellipsoid up to 16:1 ([`NormalField::semi_axes_through`]) also at most a quarter of
-    /// `beta_min` times its sharpest bend's radius.
+    /// `beta_min` times its sharpest bend's radius. On a non-integrable field, whose sheet may
+    /// run into a singular point of the field, up to 10⁻² step scales but at most 4·10⁻³
+    /// extent scales.
     pub dt_min: Option<f64>,
     /// Largest step; automatic: half the step scale, at most a twelfth of `max_radius`, and
     /// on an ellipsoid up to 16:1 at most its shortest semi-axis.
