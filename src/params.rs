@@ -353,11 +353,11 @@ const AUTO_DT_MIN: f64 = 1e-3;
 /// field's singular point, which for an invariant (the origin) lies within an extent of
 /// `p0`; with the integrable fields' clamp, a hundredth of Δt, the curves crawled round it:
 /// a random 18-number sweep from 0.04 off the origin laid 866,629 samples for 6,073
-/// triangles in 35 s (2.7 s with this clamp). The cap by the extent keeps the old clamp where
+/// triangles in 35 s (2.5 s with this clamp). The cap by the extent keeps the old clamp where
 /// the sheet is flat at `p0` and its step scale several extents long (a twisted linear
 /// invariant 1.3 off the origin with a radius of curvature of 19.5 there kept 249
 /// triangles; a tenth of Δt left 159).
-const AUTO_DT_MIN_SWEPT: f64 = 1e-2;
+const AUTO_DT_MIN_SWEPT: f64 = AUTO_DT / 10.0;
 /// See [`AUTO_DT_MIN_SWEPT`].
 const SWEPT_DT_MIN_OF_EXTENT: f64 = 4e-3;
 const AUTO_DT_MAX: f64 = 0.5;
@@ -433,8 +433,9 @@ impl MeshParams {
             .map_or((f64::INFINITY, f64::INFINITY), |[s0, _, s2]| {
                 (s0, s0 * s0 / s2)
             });
+        let integrable = shape.is_integrable();
         let max_radius = self.max_radius.unwrap_or(
-            if shape.is_integrable() {
+            if integrable {
                 AUTO_RADIUS
             } else {
                 AUTO_RADIUS_SWEPT
@@ -448,7 +449,7 @@ impl MeshParams {
         let dt_min = self.dt_min.unwrap_or_else(|| {
             let quarter_band = 0.25 * self.beta_min.radians();
             let clamp = (AUTO_DT_MIN.min(quarter_band) * scales.step).min(quarter_band * sharpest);
-            let auto = if shape.is_integrable() {
+            let auto = if integrable {
                 clamp
             } else {
                 clamp.max(
