@@ -382,6 +382,35 @@ pub fn step_fixed<T: Scalar, F: NormalField<T>>(
     }
 }
 
+/// How far the straight chord from `p` to `q` ends off the level set through `p`, as
+/// estimated for a field with a potential (`v = ∇F`).
+///
+/// A drift-free chord makes Simpson's rule for `∫ v·dp` along it vanish; Boole's rule on the
+/// same segment is two orders higher, so their difference estimates what Simpson's rule
+/// missed, the potential `F(q) − F(p)`, which divided by `|v(q)|` is a distance. Both rules
+/// are exact where the potential is a cubic (every integrable field of the model): then the
+/// estimate is rounding. Four field values, in `f64`.
+pub(crate) fn chord_drift<T: Scalar, F: NormalField<T>>(
+    field: &F,
+    p: &Vec3<T>,
+    q: &Vec3<T>,
+) -> f64 {
+    let (a, b) = (p.to_f64(), q.to_f64());
+    let d = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
+    let along = |t: f64| -> f64 {
+        let x = Vec3::<T>::from_f64([a[0] + t * d[0], a[1] + t * d[1], a[2] + t * d[2]]);
+        let v = field.normal(&x).to_f64();
+        v[0] * d[0] + v[1] * d[1] + v[2] * d[2]
+    };
+    let [f0, f1, f2, f3] = [0.0, 0.25, 0.5, 0.75].map(along);
+    let end = field.normal(q).to_f64();
+    let f4 = end[0] * d[0] + end[1] * d[1] + end[2] * d[2];
+    let simpson = (f0 + 4.0 * f2 + f4) / 6.0;
+    let boole = (7.0 * (f0 + f4) + 32.0 * (f1 + f3) + 12.0 * f2) / 90.0;
+    let speed = (end[0] * end[0] + end[1] * end[1] + end[2] * end[2]).sqrt();
+    ((boole - simpson) / speed).abs()
+}
+
 struct Chord<T> {
     point: Vec3<T>,
     direction: Vec3<T>,
