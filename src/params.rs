@@ -312,6 +312,10 @@ pub struct Resolved {
     pub max_radius: f64,
     /// Bounding box half-size.
     pub bounding_box: f64,
+    /// Whether each chord is corrected back onto its level set: a field integrable at `p0`
+    /// that is not known to be the gradient of a cubic
+    /// ([`NormalField::has_cubic_potential`](crate::NormalField::has_cubic_potential)).
+    pub level_correction: bool,
 }
 
 impl Resolved {
@@ -480,6 +484,7 @@ impl MeshParams {
             dt_max,
             max_radius,
             bounding_box: self.bounding_box.unwrap_or(AUTO_BOX * scales.extent),
+            level_correction: integrable && !field.has_cubic_potential(),
         };
         resolved.check_lengths()?;
         Ok(resolved)

@@ -708,7 +708,9 @@ impl liemesh::model::FieldFormula for RoundTorus {
 /// the front placed by its inner equator lay 6.9e-4 off the torus (relative), the samples at
 /// most 1.4e-5: the two half chords that reach it turn fast there, and the potential is not a
 /// cubic, so Simpson's rule inside each chord drifts. A hop whose drift, estimated against
-/// Boole's rule, exceeds 1e-4 of its length is now taken again as two (4.7e-5).
+/// Boole's rule, exceeds 1e-4 of its length is now taken again as two (4.7e-5), and every
+/// chord on a field whose potential is not a cubic is moved back onto its level set by
+/// that estimate (`trace::on_level`; with both, 1.6e-7).
 #[test]
 fn a_new_point_of_the_front_on_a_fat_torus_stays_on_it() {
     let (big0, fat, scale, u, v) = (
@@ -738,5 +740,5 @@ fn a_new_point_of_the_front_on_a_fat_torus_stays_on_it() {
             (((rho - big) / small).powi(2) + (w[2] / small).powi(2) - 1.0).abs()
         })
         .fold(0.0, f64::max);
-    assert!(worst < 1e-4, "worst relative drift {worst:e}");
+    assert!(worst < 1e-6, "worst relative drift {worst:e}");
 }

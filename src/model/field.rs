@@ -74,6 +74,17 @@ pub trait NormalField<T: Scalar>: Sync {
         let _ = p0;
         None
     }
+
+    /// Whether the field is exactly the gradient of a polynomial of degree at most three, as
+    /// every integrable invariant's field is. The drift-free chord is exact on such a field
+    /// (Simpson's rule integrates its quadratic `v·dp` exactly). On any other integrable field
+    /// each chord is corrected back onto its level set (its potential error estimated with
+    /// Boole's rule, removed by a step along the normal), at four more field values a step.
+    /// The default, `false`, is always safe; `true` on a field that is not such a gradient
+    /// leaves its chords' drift uncorrected.
+    fn has_cubic_potential(&self) -> bool {
+        false
+    }
 }
 
 impl<T: Scalar, F: NormalField<T> + ?Sized> NormalField<T> for &F {
@@ -94,6 +105,9 @@ impl<T: Scalar, F: NormalField<T> + ?Sized> NormalField<T> for &F {
     }
     fn semi_axes_through(&self, p0: [f64; 3]) -> Option<[f64; 3]> {
         (**self).semi_axes_through(p0)
+    }
+    fn has_cubic_potential(&self) -> bool {
+        (**self).has_cubic_potential()
     }
 }
 
@@ -233,6 +247,21 @@ impl<T: Scalar> NormalField<T> for LieField<T> {
 
     fn in_f64(&self) -> Option<&dyn NormalField<f64>> {
         self.in_f64.as_deref().map(|f| f as &dyn NormalField<f64>)
+    }
+
+    /// `A` symmetric and `B` diagonal, exactly: `v = ∇(½ pᵀ A p + Σ Bᵢᵢ pᵢ³ / 3)`.
+    fn has_cubic_potential(&self) -> bool {
+        let (a, b) = (&self.a, &self.b);
+        let entry = |m: &Mat3<T>, i: usize, j: usize| match j {
+            0 => m[i].x.clone(),
+            1 => m[i].y.clone(),
+            _ => m[i].z.clone(),
+        };
+        (0..3).all(|i| {
+            (0..3).all(|j| {
+                i == j || (entry(a, i, j) == entry(a, j, i) && entry(b, i, j) == T::zero())
+            })
+        }) && (!self.quadratic || matches!(self.lift, Lift::Squares))
     }
 
     /// For a quadric (`B = 0`, `A` symmetric: the level set `pᵀ A p = c` through `p0`), its

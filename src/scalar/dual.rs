@@ -241,6 +241,21 @@ impl<T: Scalar> Scalar for Dual<T> {
         }
     }
     #[inline(always)]
+    fn exp(&self) -> Self {
+        let e = self.re.exp();
+        Dual::new(e.clone(), self.eps.clone() * e)
+    }
+    #[inline(always)]
+    fn ln(&self) -> Self {
+        Dual::new(self.re.ln(), self.eps.clone() / self.re.clone())
+    }
+    #[inline(always)]
+    fn powf(&self, p: f64) -> Self {
+        // d(x^p) = p x^(p−1) dx, written so that it is 0, not 0·∞, at x = 0 for p > 1.
+        let slope = self.re.powf(p - 1.0) * T::from_f64(p);
+        Dual::new(self.re.powf(p), self.eps.clone() * slope)
+    }
+    #[inline(always)]
     fn is_finite(&self) -> bool {
         self.re.is_finite() && self.eps.is_finite()
     }
@@ -266,10 +281,20 @@ mod tests {
             (x.sqrt().eps, 0.5 / 0.7_f64.sqrt()),
             ((Dual::constant(1.0) / x.clone()).eps, -1.0 / 0.49),
             (x.atan2(&Dual::constant(2.0)).eps, 2.0 / (4.0 + 0.49)),
+            (x.exp().eps, 0.7_f64.exp()),
+            (x.ln().eps, 1.0 / 0.7),
+            (x.powf(2.5).eps, 2.5 * 0.7_f64.powf(1.5)),
         ];
         for (got, want) in checks {
             assert!((got - want).abs() < 1e-14, "{got} vs {want}");
         }
+    }
+
+    #[test]
+    fn a_power_above_one_has_slope_zero_at_zero() {
+        // |x|^p of a superquadric at x = 0: 0, not 0·∞ = NaN.
+        let d = Dual::variable(0.0_f64).powf(4.0);
+        assert_eq!((d.re, d.eps), (0.0, 0.0));
     }
 
     #[test]

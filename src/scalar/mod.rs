@@ -101,6 +101,12 @@ pub trait Scalar:
     fn atan2(&self, x: &Self) -> Self;
     /// Absolute value.
     fn abs(&self) -> Self;
+    /// Exponential, `e^self` (Gaussian blobs, soft unions).
+    fn exp(&self) -> Self;
+    /// Natural logarithm (NaN below zero, −∞ at zero, as `f64::ln`).
+    fn ln(&self) -> Self;
+    /// `self` to the real power `p`, as `f64::powf` (superquadrics' `|x|^p`).
+    fn powf(&self, p: f64) -> Self;
     /// `true` unless the value (or any part of it) is infinite or NaN.
     fn is_finite(&self) -> bool;
     /// Unit roundoff of the type (half the machine epsilon), as an `f64`.
@@ -143,6 +149,18 @@ macro_rules! impl_scalar_for_float {
             #[inline(always)]
             fn abs(&self) -> Self {
                 <$t>::abs(*self)
+            }
+            #[inline(always)]
+            fn exp(&self) -> Self {
+                <$t>::exp(*self)
+            }
+            #[inline(always)]
+            fn ln(&self) -> Self {
+                <$t>::ln(*self)
+            }
+            #[inline(always)]
+            fn powf(&self, p: f64) -> Self {
+                <$t>::powf(*self, p as $t)
             }
             #[inline(always)]
             fn is_finite(&self) -> bool {

@@ -192,6 +192,15 @@ impl<const BITS: u32> Scalar for Mpfr<BITS> {
     fn abs(&self) -> Self {
         Mpfr(self.0.clone().abs())
     }
+    fn exp(&self) -> Self {
+        Mpfr(self.0.clone().exp())
+    }
+    fn ln(&self) -> Self {
+        Mpfr(self.0.clone().ln())
+    }
+    fn powf(&self, p: f64) -> Self {
+        Mpfr(self.0.clone().pow(p))
+    }
     fn is_finite(&self) -> bool {
         self.0.is_finite()
     }
@@ -246,5 +255,22 @@ mod tests {
         let pi = Mpfr::<128>::pi();
         let a = Mpfr::<128>::zero().atan2(&Mpfr::from_f64(-1.0));
         assert!((pi - a).abs().to_f64() < 1e-37);
+    }
+
+    #[test]
+    fn exp_ln_and_powf_agree_with_f64_and_invert_each_other() {
+        let x = Mpfr::<256>::from_f64(0.7);
+        for (got, want) in [
+            (x.exp().to_f64(), 0.7_f64.exp()),
+            (x.ln().to_f64(), 0.7_f64.ln()),
+            (x.powf(2.5).to_f64(), 0.7_f64.powf(2.5)),
+        ] {
+            assert!(
+                (got - want).abs() <= 2.0 * f64::EPSILON * want.abs(),
+                "{got} vs {want}"
+            );
+        }
+        let back = x.ln().exp();
+        assert!((back - x).abs().to_f64() < 1e-75);
     }
 }

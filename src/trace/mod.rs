@@ -29,6 +29,8 @@ pub struct StepConfig<T> {
     /// `cos(OVERSHOOT · β_max)`; −∞ when that angle is a half turn or more (no step
     /// overshoots it).
     overshoot_cos: f64,
+    /// Whether chords are corrected back onto their level set ([`Resolved::level_correction`]).
+    level_correction: bool,
 }
 
 impl<T: Scalar> StepConfig<T> {
@@ -45,6 +47,7 @@ impl<T: Scalar> StepConfig<T> {
             dt_min: T::from_f64(params.dt_min),
             dt_max: T::from_f64(params.dt_max),
             max_retries: params.max_retries,
+            level_correction: params.level_correction && params.mode == Mode::Default,
             overshoot_cos: {
                 let angle = OVERSHOOT * params.beta_max.radians();
                 if angle < std::f64::consts::PI {
@@ -325,8 +328,13 @@ pub fn step<T: Scalar, F: NormalField<T>>(
                 .direction
                 .scale(&(cw.clone() + cw))
                 .add_scaled(&-T::one(), &w);
+            let point = if cfg.level_correction {
+                on_level(field, p, &v, &chord, &dt)
+            } else {
+                chord.point
+            };
             Ok(Step {
-                point: chord.point,
+                point,
                 next_normal: predicted_normal(&v, &jw, &dt),
                 carry,
                 tangent: w,
@@ -373,7 +381,9 @@ pub fn step_fixed<T: Scalar, F: NormalField<T>>(
                 w: &w,
             };
             let chord = drift_free_chord(field, cfg, &start, length, &kappa)?;
-            if chord.converged {
+            if chord.converged && cfg.level_correction {
+                Ok(on_level(field, p, &v, &chord, length))
+            } else if chord.converged {
                 Ok(chord.point)
             } else {
                 Err(StepStop::NoChord)
@@ -409,6 +419,43 @@ pub(crate) fn chord_drift<T: Scalar, F: NormalField<T>>(
     let boole = (7.0 * (f0 + f4) + 32.0 * (f1 + f3) + 12.0 * f2) / 90.0;
     let speed = (end[0] * end[0] + end[1] * end[1] + end[2] * end[2]).sqrt();
     ((boole - simpson) / speed).abs()
+}
+
+/// The end of `chord` (of `length`, from `p` where the field is `v0`) moved back onto the
+/// level set through `p`, on a field `v = ∇F` whose potential is not a cubic.
+///
+/// The chord makes Simpson's rule for `F(q) − F(p) = ∫ v·dp` vanish, which is exact only for
+/// cubic potentials; Boole's rule on the same segment is two orders higher, so what it gives
+/// is what the chord left of the rise (a quartic potential's truncation error is of the fifth
+/// order in the length, this one's of the seventh). The end moves against it along `v(q)`:
+/// `q − (ΔF / |v(q)|²) v(q)`. (A superellipsoid's curves drifted 7.3e-4 of its size so.)
+fn on_level<T: Scalar, F: NormalField<T>>(
+    field: &F,
+    p: &Vec3<T>,
+    v0: &Vec3<T>,
+    chord: &Chord<T>,
+    length: &T,
+) -> Vec3<T> {
+    let c = &chord.direction;
+    let along = |t: f64| {
+        field
+            .normal(&p.add_scaled(&(length.clone() * T::from_f64(t)), c))
+            .dot(c)
+    };
+    let end = field.normal(&chord.point);
+    let (f0, f4) = (v0.dot(c), end.dot(c));
+    let (f1, f2, f3) = (along(0.25), along(0.5), along(0.75));
+    let rise = length.clone()
+        * (T::from_f64(7.0) * (f0 + f4) + T::from_f64(32.0) * (f1 + f3) + T::from_f64(12.0) * f2)
+        / T::from_f64(90.0);
+    let moved = chord
+        .point
+        .add_scaled(&(-(rise / end.norm_squared())), &end);
+    if moved.is_finite() {
+        moved
+    } else {
+        chord.point.clone()
+    }
 }
 
 struct Chord<T> {
@@ -996,6 +1043,9 @@ mod tests {
         }
         fn in_f64(&self) -> Option<&dyn NormalField<f64>> {
             self.0.in_f64()
+        }
+        fn has_cubic_potential(&self) -> bool {
+            self.0.has_cubic_potential()
         }
     }
 

@@ -1,0 +1,246 @@
+//! Closed surfaces of a user's own, written as [`FieldFormula`]s (gradients of implicit
+//! functions, with `exp` and `powf` where the surface calls for them), at random scales and
+//! from random points on them: every mesh must be valid, closed, of the surface's genus, and
+//! on the surface.
+//!
+//! `PROPTEST_CASES` sets how many cases (default [`CASES`]), `PROPTEST_RNG_SEED` the seed.
+
+use liemesh::model::{FieldFormula, Formula};
+use liemesh::scalar::{Scalar, Vec3};
+use liemesh::{run, MeshParams};
+use proptest::prelude::*;
+use proptest::test_runner::{Config, RngSeed, TestCaseError, TestRunner};
+
+/// Cases per run of the test when `PROPTEST_CASES` is not set.
+const CASES: u32 = 16;
+
+/// The largest relative drift `|F − level| / (|∇F| · size)` a vertex may have: the chord rule
+/// is exact only for cubic potentials, so on these it is small, not rounding.
+const DRIFT: f64 = 1e-4;
+
+/// The share of meshes (percent) that may miss their surface's genus, counted and printed
+/// with `(counted)`, as the class tests allow their tori and bands (`tests/classes.rs`): at
+/// 128 cases a superellipsoid started on its flat face (meshed at the spacing the face asks
+/// for, coarse for its rounded edges) kept a 15-edge hole, and a tanglecube two small ones.
+/// Validity, completeness and drift are never tolerated.
+const MISSES_PERCENT: u32 = 5;
+
+/// A closed surface `F(p / scale) = level`, its field `∇F(p / scale)`.
+#[derive(Clone, Copy, Debug)]
+enum Surface {
+    /// Two Gaussian blobs merged into one: `Σ exp(−|p − cᵢ|²) = 0.5`, `cᵢ = (±0.7, 0, 0)`.
+    Blobs,
+    /// A superellipsoid `|x|^4.5 + |y/1.5|^4.5 + |z/0.8|^4.5 = 1`.
+    Superellipsoid,
+    /// A double torus `(x(x − 1)²(x − 2) + y²)² + z² = 0.01`.
+    DoubleTorus,
+    /// The tanglecube `x⁴ − 5x² + y⁴ − 5y² + z⁴ − 5z² = −11.8`.
+    Tanglecube,
+}
+
+impl Surface {
+    const ALL: [Surface; 4] = [
+        Surface::Blobs,
+        Surface::Superellipsoid,
+        Surface::DoubleTorus,
+        Surface::Tanglecube,
+    ];
+
+    fn genus(self) -> u64 {
+        match self {
+            Surface::Blobs | Surface::Superellipsoid => 0,
+            Surface::DoubleTorus => 2,
+            Surface::Tanglecube => 5,
+        }
+    }
+
+    fn level(self) -> f64 {
+        match self {
+            Surface::Blobs => 0.5,
+            Surface::Superellipsoid => 1.0,
+            Surface::DoubleTorus => 0.01,
+            Surface::Tanglecube => -11.8,
+        }
+    }
+
+    /// A point inside (on the side of the surface that a ray from it leaves).
+    fn inside(self) -> [f64; 3] {
+        match self {
+            Surface::Blobs => [0.7, 0.0, 0.0],
+            Surface::Superellipsoid => [0.0, 0.0, 0.0],
+            Surface::DoubleTorus => [0.5, 0.1875f64.sqrt(), 0.0],
+            Surface::Tanglecube => [2.5f64.sqrt(); 3],
+        }
+    }
+
+    /// Whether `F` at a point inside is below the level (the surface is where `F` crosses it).
+    fn below_inside(self) -> bool {
+        !matches!(self, Surface::Blobs)
+    }
+
+    /// `F` and `∇F` at `p` (in the surface's own units).
+    fn value<T: Scalar>(self, p: &Vec3<T>) -> (T, Vec3<T>) {
+        let c = |x: f64| T::from_f64(x);
+        let (x, y, z) = (p.x.clone(), p.y.clone(), p.z.clone());
+        match self {
+            Surface::Blobs => {
+                let (mut f, mut g) = (c(0.0), Vec3::new(c(0.0), c(0.0), c(0.0)));
+                for cx in [-0.7, 0.7] {
+                    let d = Vec3::new(x.clone() - c(cx), y.clone(), z.clone());
+                    let w = (-d.norm_squared()).exp();
+                    g = g.add_scaled(&(c(-2.0) * w.clone()), &d);
+                    f += w;
+                }
+                (f, g)
+            }
+            Surface::Superellipsoid => {
+                let term = |u: T, a: f64| {
+                    let u = u / c(a);
+                    let m = u.abs().powf(2.5);
+                    // |u|^4.5 and its derivative 4.5 u |u|^2.5 / a.
+                    (m.clone() * u.clone() * u.clone(), c(4.5 / a) * u * m)
+                };
+                let (fx, gx) = term(x, 1.0);
+                let (fy, gy) = term(y, 1.5);
+                let (fz, gz) = term(z, 0.8);
+                (fx + fy + fz, Vec3::new(gx, gy, gz))
+            }
+            Surface::DoubleTorus => {
+                let x2 = x.clone() * x.clone();
+                let g = x2.clone() * x2.clone() - c(4.0) * x2.clone() * x.clone()
+                    + c(5.0) * x2.clone()
+                    - c(2.0) * x.clone();
+                let dg = c(4.0) * x2.clone() * x.clone() - c(12.0) * x2 + c(10.0) * x - c(2.0);
+                let h = g + y.clone() * y.clone();
+                (
+                    h.clone() * h.clone() + z.clone() * z.clone(),
+                    Vec3::new(c(2.0) * h.clone() * dg, c(4.0) * h * y, c(2.0) * z),
+                )
+            }
+            Surface::Tanglecube => {
+                let term = |u: T| {
+                    let u2 = u.clone() * u.clone();
+                    (
+                        u2.clone() * u2.clone() - c(5.0) * u2.clone(),
+                        c(4.0) * u2 * u.clone() - c(10.0) * u,
+                    )
+                };
+                let ((fx, gx), (fy, gy), (fz, gz)) = (term(x), term(y), term(z));
+                (fx + fy + fz, Vec3::new(gx, gy, gz))
+            }
+        }
+    }
+}
+
+/// The field of a [`Surface`] scaled by `scale`.
+#[derive(Clone)]
+struct Scaled {
+    surface: Surface,
+    scale: f64,
+}
+
+impl FieldFormula for Scaled {
+    fn normal<T: Scalar>(&self, p: &Vec3<T>) -> Vec3<T> {
+        let k = T::from_f64(1.0 / self.scale);
+        self.surface.value(&p.scale(&k)).1
+    }
+}
+
+/// The first point where the ray from the surface's inside point along `d` crosses the
+/// surface (in the surface's own units), by marching and bisection.
+fn on_surface(surface: Surface, d: [f64; 3]) -> Option<[f64; 3]> {
+    let start = surface.inside();
+    let at = |t: f64| [0, 1, 2].map(|k| start[k] + t * d[k]);
+    let outside = |t: f64| {
+        let f = surface.value(&Vec3::<f64>::from_f64(at(t))).0 - surface.level();
+        if surface.below_inside() {
+            f > 0.0
+        } else {
+            f < 0.0
+        }
+    };
+    let (mut lo, mut hi) = (0.0, 1e-3);
+    while !outside(hi) {
+        lo = hi;
+        hi += 1e-3;
+        if hi > 10.0 {
+            return None;
+        }
+    }
+    for _ in 0..80 {
+        let mid = 0.5 * (lo + hi);
+        if outside(mid) {
+            hi = mid;
+        } else {
+            lo = mid;
+        }
+    }
+    Some(at(0.5 * (lo + hi)))
+}
+
+fn runner() -> TestRunner {
+    let mut config = Config {
+        failure_persistence: None,
+        // A failing case is reported as drawn: shrinking reruns the mesher many times.
+        max_shrink_iters: 0,
+        ..Config::default()
+    };
+    if config.rng_seed == RngSeed::Random {
+        config.rng_seed = RngSeed::Fixed(0x05e1_f5ea);
+    }
+    if std::env::var_os("PROPTEST_CASES").is_none() {
+        config.cases = CASES;
+    }
+    TestRunner::new(config)
+}
+
+#[test]
+fn closed_user_surfaces_of_genus_zero_two_and_five_mesh_whole() {
+    let case = (
+        0..Surface::ALL.len(),
+        -3.0f64..3.0,
+        (-1.0f64..1.0, -1.0f64..1.0, -1.0f64..1.0),
+    );
+    let mut runner = runner();
+    let cases = runner.config().cases;
+    let misses = std::cell::Cell::new(0u32);
+    runner
+        .run(&case, |(which, log_scale, (a, b, c))| {
+            let surface = Surface::ALL[which];
+            let norm = (a * a + b * b + c * c).sqrt();
+            prop_assume!(norm > 0.1);
+            let Some(unit_point) = on_surface(surface, [a / norm, b / norm, c / norm]) else {
+                return Err(TestCaseError::reject("the ray does not leave"));
+            };
+            let scale = 10f64.powf(log_scale);
+            let p0 = unit_point.map(|x| x * scale);
+            let field = Formula(Scaled { surface, scale });
+            let what = format!("{surface:?} at scale {scale:e} from {p0:?}");
+            let run = run::<f64, _>(&field, &MeshParams::at(p0))
+                .map_err(|e| TestCaseError::fail(format!("{what}: {e}")))?;
+            let v = &run.validation;
+            prop_assert!(v.is_valid(), "{what}: {v}");
+            prop_assert!(run.cut_short().is_empty(), "{what}: {:?}", run.cut_short());
+            if v.genus() != Some(surface.genus()) {
+                eprintln!("{what}: {v} (counted)");
+                misses.set(misses.get() + 1);
+            }
+            let worst = run
+                .mesh
+                .vertices
+                .iter()
+                .map(|w| {
+                    let (f, g) = surface.value(&Vec3::<f64>::from_f64(w.map(|x| x / scale)));
+                    ((f - surface.level()) / g.norm()).abs()
+                })
+                .fold(0.0, f64::max);
+            prop_assert!(worst <= DRIFT, "{what}: drift {worst:e}");
+            Ok(())
+        })
+        .unwrap();
+    let misses = misses.get();
+    assert!(
+        misses * 100 <= MISSES_PERCENT * cases,
+        "{misses} of {cases} meshes had the wrong topology (at most {MISSES_PERCENT}% allowed)"
+    );
+}
