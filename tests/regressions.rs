@@ -742,3 +742,43 @@ fn a_new_point_of_the_front_on_a_fat_torus_stays_on_it() {
         .fold(0.0, f64::max);
     assert!(worst < 1e-6, "worst relative drift {worst:e}");
 }
+
+/// The superellipsoid `|x|^4.5 + |y/1.5|^4.5 + |z/0.8|^4.5 = 1` (half its gradient over 2.25).
+struct Superellipsoid;
+
+impl liemesh::model::FieldFormula for Superellipsoid {
+    fn normal<T: liemesh::scalar::Scalar>(&self, p: &Vec3<T>) -> Vec3<T> {
+        let term = |u: T, a: f64| {
+            let u = u / T::from_f64(a);
+            let m = u.abs().powf(2.5);
+            T::from_f64(1.0 / a) * u * m
+        };
+        Vec3::new(
+            term(p.x.clone(), 1.0),
+            term(p.y.clone(), 1.5),
+            term(p.z.clone(), 0.8),
+        )
+    }
+}
+
+/// Found by `tests/user_surfaces.rs` at 256 cases: from a point near the middle of a
+/// superellipsoid's flat top face, the centres of curvature lie hundreds of sizes away, the
+/// automatic Δt came out as 36 for a surface 3 across, every curve ended at its first step,
+/// and the run failed with "only 1 sample point". The automatic lengths are now shortened
+/// (16-fold, twice at most) when the curves lay no sample beyond `p0`.
+#[test]
+fn a_superellipsoid_closes_from_near_the_middle_of_its_flat_face() {
+    let scale = 11.53797596445112;
+    let p0 = [0.2936633665129353, 1.5061045393952748, 9.230345931476903].map(|x| x / scale);
+    let run = liemesh::run::<f64, _>(
+        &liemesh::model::Formula(Superellipsoid),
+        &MeshParams::at(p0),
+    )
+    .unwrap();
+    assert!(
+        run.validation.is_closed() && run.validation.genus() == Some(0),
+        "{}",
+        run.validation
+    );
+    assert!(run.params.dt < 36.0 / 16.0 * 1.0001, "Δt {}", run.params.dt);
+}

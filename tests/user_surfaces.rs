@@ -28,9 +28,7 @@ const DRIFT: f64 = 3e-4;
 /// docs/status.md): a superellipsoid started on its flat face is meshed at the spacing the
 /// face asks for, coarse for its rounded edges, and kept a hole there or ended a curve with
 /// no chord down to `dt_min`; a tanglecube kept two small holes, another ran out of the
-/// stitching budget; a superellipsoid started at the middle of its flat face ended every
-/// curve at once (a typed error: "only 1 sample point"). Validity and drift are never
-/// tolerated.
+/// stitching budget. Validity and drift are never tolerated.
 const MISSES_PERCENT: u32 = 5;
 
 /// A closed surface `F(p / scale) = level`, its field `∇F(p / scale)`.
