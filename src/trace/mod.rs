@@ -425,9 +425,9 @@ pub(crate) fn chord_drift<T: Scalar, F: NormalField<T>>(
 /// level set through `p`, on a field `v = ∇F` whose potential is not a cubic.
 ///
 /// The chord makes Simpson's rule for `F(q) − F(p) = ∫ v·dp` vanish, which is exact only for
-/// cubic potentials; Boole's rule on the same segment is two orders higher, so what it gives
-/// is what the chord left of the rise (a quartic potential's truncation error is of the fifth
-/// order in the length, this one's of the seventh). The end moves against it along `v(q)`:
+/// potentials of degree four or less; Boole's rule on the same segment is two orders higher,
+/// so what it gives is what the chord left of the rise (Simpson's truncation error is of the
+/// fifth order in the length, Boole's of the seventh). The end moves against it along `v(q)`:
 /// `q − (ΔF / |v(q)|²) v(q)`. (A superellipsoid's curves drifted 7.3e-4 of its size so.)
 fn on_level<T: Scalar, F: NormalField<T>>(
     field: &F,
