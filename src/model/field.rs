@@ -261,7 +261,11 @@ impl<T: Scalar> NormalField<T> for LieField<T> {
             (0..3).all(|j| {
                 i == j || (entry(a, i, j) == entry(a, j, i) && entry(b, i, j) == T::zero())
             })
-        }) && (!self.quadratic || matches!(self.lift, Lift::Squares))
+        }) && match self.lift {
+            // `B ℓ₂(p)` with diagonal `B` is `∇(Σ Bᵢᵢ pᵢ³ / 3)` for this lift; another lift
+            // must say whether its term is a gradient.
+            Lift::Squares => true,
+        }
     }
 
     /// For a quadric (`B = 0`, `A` symmetric: the level set `pᵀ A p = c` through `p0`), its

@@ -47,7 +47,8 @@ impl<T: Scalar> StepConfig<T> {
             dt_min: T::from_f64(params.dt_min),
             dt_max: T::from_f64(params.dt_max),
             max_retries: params.max_retries,
-            level_correction: params.level_correction && params.mode == Mode::Default,
+            // Only the default mode's chords read it.
+            level_correction: params.level_correction,
             overshoot_cos: {
                 let angle = OVERSHOOT * params.beta_max.radians();
                 if angle < std::f64::consts::PI {
