@@ -315,7 +315,7 @@ pub fn run_observed<T: Scalar, F: NormalField<T>>(
     // Pinched vertices are cut apart and only the main component is kept. The validation
     // finds both (and the faces it leaves out of its topology, which those passes may drop),
     // so on the usual mesh, which has none of them, the passes are skipped.
-    let mut validation = mesh.validate();
+    let (mut validation, mut boundary) = mesh::validate_with_boundary(&mesh);
     // Crossings that relaxation made are first relaxed away again with their vertices pinned
     // (not after refinement, which added vertices since).
     let mut pinned = 0;
@@ -328,7 +328,7 @@ pub fn run_observed<T: Scalar, F: NormalField<T>>(
             mesh::crossings(p, t)
         });
         if pinned > 0 {
-            validation = mesh.validate();
+            (validation, boundary) = mesh::validate_with_boundary(&mesh);
         }
     }
     let untidy = !validation.non_manifold_vertices.is_empty()
@@ -338,16 +338,18 @@ pub fn run_observed<T: Scalar, F: NormalField<T>>(
     if untidy {
         triangulate::unpinch(&mut mesh.triangles);
         triangulate::keep_main_component(&mut mesh);
-        validation = mesh.validate();
+        (validation, boundary) = mesh::validate_with_boundary(&mesh);
     }
     let mut untangled = triangulate::Untangled::default();
     if !validation.self_intersections.is_empty() {
         untangled = triangulate::untangle(&mut mesh, &mut vertices, before.as_ref(), |p, t| {
             mesh::crossings(p, t)
         });
-        validation = mesh.validate();
+        (validation, boundary) = mesh::validate_with_boundary(&mesh);
     }
     untangled.pinned = pinned;
+    let mut stitched = stitched;
+    stitched.holes = triangulate::holes(&samples, &mesh, &boundary);
     triangulate::drop_unused(&mut mesh, &mut vertices);
     // The refinement's count of faces over the bound, on the mesh as returned.
     let mut refinement = refinement;

@@ -145,12 +145,29 @@ fn check_with<F: NormalField<f64>>(
         Shape::Nappe => (chi == 1 && loops == 1) || (chi == 0 && loops == 2),
         Shape::Swept(least) => topology.faces >= least,
     };
+    // The run tells a hole (a boundary loop where the surface goes on) from its own rim: a
+    // surface that came out whole has none (a disc with a hole has a band's χ and loops),
+    // a closed one that did not close has one at least.
+    let holes = run.stitched.holes;
+    match shape {
+        Shape::Closed(_) | Shape::Band | Shape::Disc if fits => {
+            prop_assert_eq!(holes, 0, "{}: holes reported", context)
+        }
+        Shape::Closed(_)
+            if !topology.closed
+                && run.cut_short().is_empty()
+                && run.samples.ends().singular == 0 =>
+        {
+            prop_assert!(holes > 0, "{context}: open, yet no hole reported")
+        }
+        _ => {}
+    }
     if !fits {
         if let Some(misses) = MISSES.with(|m| m.get()) {
             // A class whose topology is not yet always right (see the module table): the
             // miss is counted, the mesh is still valid.
             MISSES.with(|m| m.set(Some(misses + 1)));
-            eprintln!("{context}: expected {shape:?} (counted)");
+            eprintln!("{context}: expected {shape:?}, {holes} holes (counted)");
             return Ok(run);
         }
     }

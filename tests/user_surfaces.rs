@@ -235,8 +235,19 @@ fn closed_user_surfaces_of_genus_zero_two_and_five_mesh_whole() {
             prop_assert!(v.is_valid(), "{what}: {v}");
             // A run cut short by a budget says so, and counts as a miss (as in the class
             // tests); its mesh must still be valid.
+            // A closed surface that did not close has a hole, and the run says so (unless
+            // curves ended beside it as at a singular point, which is then its rim).
+            let holes = run.stitched.holes;
+            if v.is_closed() {
+                prop_assert_eq!(holes, 0, "{}: closed, yet holes reported", what);
+            } else if run.cut_short().is_empty() && run.samples.ends().singular == 0 {
+                prop_assert!(holes > 0, "{what}: {v}, yet no hole reported");
+            }
             if v.genus() != Some(surface.genus()) || !run.cut_short().is_empty() {
-                eprintln!("{what}: {v}, cut short {:?} (counted)", run.cut_short());
+                eprintln!(
+                    "{what}: {v}, {holes} holes, cut short {:?} (counted)",
+                    run.cut_short()
+                );
                 misses.set(misses.get() + 1);
             }
             let worst = run

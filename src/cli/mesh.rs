@@ -612,6 +612,15 @@ fn print_summary(r: &Report, mesh: Option<&Path>, report: Option<&Path>) {
     if let Some(v) = &r.validation {
         println!("  validation {v}");
     }
+    let holes = r.stitched.holes;
+    if holes > 0 {
+        println!(
+            "  holes      {holes} boundary loop{} where the surface goes on (none of its \
+             vertices at the radius, the box, a singular point or a budget): fronts that met \
+             and were not stitched, or a swept surface cut back",
+            if holes == 1 { "" } else { "s" }
+        );
+    }
     if r.untangled.removed + r.untangled.reverted > 0 {
         println!(
             "  untangled  {} relaxation moves taken back, {} crossing faces removed",

@@ -6,6 +6,12 @@
 mod validate;
 pub use validate::{Offenders, Validation, MAX_EXAMPLES};
 
+/// The validation of `mesh` and its boundary edges, as `(low, high)` vertex pairs in order.
+pub(crate) fn validate_with_boundary(mesh: &Mesh) -> (Validation, Vec<(u32, u32)>) {
+    let listed = validate::validate_listing(&mesh.vertices, &mesh.triangles);
+    (listed.validation, listed.boundary)
+}
+
 /// Every self-intersecting pair of faces (lower index first, in order), decided exactly.
 pub(crate) fn crossings(p: &[[f64; 3]], tris: &[[u32; 3]]) -> Vec<(usize, usize)> {
     validate::validate_listing_crossings(p, tris).1

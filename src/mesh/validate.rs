@@ -298,7 +298,7 @@ const PARALLEL_FACES: usize = 1024;
 /// vertex fans and the broad phase fast (both are bound by memory access, not arithmetic);
 /// offenders are translated back to the caller's numbers.
 pub(crate) fn validate(p: &[P3], tris: &[[u32; 3]]) -> Validation {
-    validate_listing_crossings(p, tris).0
+    validate_listing(p, tris).validation
 }
 
 /// [`validate`], and every self-intersecting pair of faces (lower index first, in order).
@@ -306,6 +306,22 @@ pub(crate) fn validate_listing_crossings(
     p: &[P3],
     tris: &[[u32; 3]],
 ) -> (Validation, Vec<(usize, usize)>) {
+    let listed = validate_listing(p, tris);
+    (listed.validation, listed.crossings)
+}
+
+/// A validation with the lists behind two of its counts.
+pub(crate) struct Listed {
+    /// The validation.
+    pub validation: Validation,
+    /// Every self-intersecting pair of faces, lower index first, in order.
+    pub crossings: Vec<(usize, usize)>,
+    /// Every boundary edge, as `(low, high)` vertex pairs, in order.
+    pub boundary: Vec<(u32, u32)>,
+}
+
+/// [`validate`], listing every self-intersecting pair and every boundary edge.
+pub(crate) fn validate_listing(p: &[P3], tris: &[[u32; 3]]) -> Listed {
     let n = p.len();
     let mut v = Validation {
         vertices: 0,
@@ -361,7 +377,8 @@ pub(crate) fn validate_listing_crossings(
     drop(rank);
     // Topology and geometry read the same arrays and write apart: on large meshes they run
     // side by side.
-    let mut topology_part = || topology(&faces, n, &old_vertex, &mut v);
+    let mut boundary = Vec::new();
+    let mut topology_part = || boundary = topology(&faces, n, &old_vertex, &mut v);
     let geometry_part = || {
         // Geometry on the faces whose corners are finite. The predicates must be exact on
         // every coordinate they see: directly if all lie in robust's window, else on a copy
@@ -411,12 +428,23 @@ pub(crate) fn validate_listing_crossings(
         v.self_intersections.push(pair);
     }
     all.sort_unstable();
-    (v, all)
+    boundary.sort_unstable();
+    Listed {
+        validation: v,
+        crossings: all,
+        boundary,
+    }
 }
 
 /// Counts, edges, fans, components and boundary loops of `faces` (all proper, over `n`
-/// vertices), offenders named by `old_vertex`.
-fn topology(faces: &[[u32; 3]], n: usize, old_vertex: &[u32], v: &mut Validation) {
+/// vertices), offenders named by `old_vertex`; returns the boundary edges, named so, as
+/// `(low, high)` pairs.
+fn topology(
+    faces: &[[u32; 3]],
+    n: usize,
+    old_vertex: &[u32],
+    v: &mut Validation,
+) -> Vec<(u32, u32)> {
     // Vertex → faces, by counting sort: faces ascending around each vertex.
     let (start, slots) =
         rows_by_corner(faces, n, |f, _| f as u32).expect("proper faces name vertices below n");
@@ -530,6 +558,7 @@ fn topology(faces: &[[u32; 3]], n: usize, old_vertex: &[u32], v: &mut Validation
     roots.sort_unstable();
     roots.dedup();
     v.boundary_loops = roots.len();
+    boundary.iter().map(|&(a, b, _)| edge(a, b)).collect()
 }
 
 /// Degenerate faces and self-intersecting pairs (as indices into `faces`) among the faces

@@ -38,6 +38,7 @@ pub(crate) use crate::mesh::octahedron;
 pub use crate::mesh::{Mesh, Provenance};
 
 use crate::error::MeshError;
+use crate::geom::union_find::UnionFind;
 use crate::geom::vec3::{cross as cross3, dist as dist3, sub as sub3, wider_than};
 use crate::model::LocalShape;
 use crate::params::Resolved;
@@ -164,6 +165,52 @@ pub(crate) fn sample_vertices<T: Scalar>(samples: &Samples<T>, mesh: &Mesh) -> V
         .collect()
 }
 
+/// Where the vertex with provenance `pr` stands: the end of a curve that ended on a terminal
+/// condition, at a singular point or on a budget, or not.
+fn rim_of<T>(samples: &Samples<T>, pr: &Provenance) -> stitch::Rim {
+    let Some(curve) = samples.curves.get(pr.curve as usize) else {
+        return stitch::Rim::Open;
+    };
+    if pr.step as usize + 1 != curve.points.len() {
+        return stitch::Rim::Open;
+    }
+    match curve.end {
+        CurveEnd::Radius | CurveEnd::BoundingBox => stitch::Rim::Terminal,
+        CurveEnd::Singular | CurveEnd::Budget => stitch::Rim::Barren,
+        CurveEnd::Collision | CurveEnd::Merge => stitch::Rim::Open,
+    }
+}
+
+/// How many loops of `boundary`'s edges (vertex pairs of `mesh`; loops that touch at a vertex
+/// count as one) have no vertex on the surface's own rim (see [`Stitched::holes`]).
+pub(crate) fn holes<T>(samples: &Samples<T>, mesh: &Mesh, boundary: &[(u32, u32)]) -> usize {
+    if boundary.is_empty() {
+        return 0;
+    }
+    // The boundary's vertices, numbered densely in ascending order.
+    let mut ends: Vec<u32> = boundary.iter().flat_map(|&(a, b)| [a, b]).collect();
+    ends.sort_unstable();
+    ends.dedup();
+    let index = |v: u32| ends.binary_search(&v).expect("a boundary vertex") as u32;
+    let mut loops = UnionFind::new(ends.len());
+    for &(a, b) in boundary {
+        loops.union(index(a), index(b));
+    }
+    // A loop is on the rim if any of its vertices is.
+    let mut on_rim = vec![false; ends.len()];
+    for (k, &v) in ends.iter().enumerate() {
+        let rim = mesh
+            .provenance
+            .get(v as usize)
+            .is_some_and(|pr| rim_of(samples, pr) != stitch::Rim::Open);
+        let root = loops.find(k as u32) as usize;
+        on_rim[root] |= rim;
+    }
+    (0..ends.len() as u32)
+        .filter(|&k| loops.find(k) == k && !on_rim[k as usize])
+        .count()
+}
+
 /// Stitches the chart mesh where its fronts meet (see the `stitch` module): triangles
 /// between boundary parts that face each other and, on an integrable field, new vertices on
 /// the surface where a gap has none. `vertices` holds the mesh's vertices in the working
@@ -182,20 +229,7 @@ pub(crate) fn stitch<T: Scalar, F: NormalField<T>>(
         let i = k * samples.points.len() / probes;
         LocalShape::at::<T, F>(field, samples.points[i].to_f64()).is_none_or(|s| s.is_integrable())
     });
-    // Ends of curves that ended on a terminal condition, a singular point or a budget.
-    let rim_of = |pr: &Provenance| {
-        let Some(curve) = samples.curves.get(pr.curve as usize) else {
-            return stitch::Rim::Open;
-        };
-        if pr.step as usize + 1 != curve.points.len() {
-            return stitch::Rim::Open;
-        }
-        match curve.end {
-            CurveEnd::Radius | CurveEnd::BoundingBox => stitch::Rim::Terminal,
-            CurveEnd::Singular | CurveEnd::Budget => stitch::Rim::Barren,
-            CurveEnd::Collision | CurveEnd::Merge => stitch::Rim::Open,
-        }
-    };
+    let rim_of = |pr: &Provenance| rim_of(samples, pr);
     let rim: Vec<stitch::Rim> = mesh.provenance.iter().map(rim_of).collect();
     let growth = stitch::Growth {
         field,
@@ -1015,6 +1049,43 @@ fn assemble<T: Scalar>(samples: &Samples<T>, pos: &[[f64; 3]], triangles: &[[u32
 mod tests {
     use super::*;
     use crate::geom::rng::XorShift64;
+
+    /// A hole cut into a closed sphere is a loop where the surface goes on; the rim of a disc
+    /// that curves ended at the geodesic radius is not, however many edges it has.
+    #[test]
+    fn holes_are_boundary_loops_away_from_the_surfaces_own_rim() {
+        use crate::preset::Preset;
+        for (preset, closed) in [(Preset::Fig3, true), (Preset::Fig6, false)] {
+            let field = crate::model::LieField::<f64>::new(&preset.invariant());
+            let run = crate::run(&field, &preset.params()).expect("the preset meshes");
+            let mut mesh = run.mesh.clone();
+            let (v, boundary) = crate::mesh::validate_with_boundary(&mesh);
+            assert_eq!(v.is_closed(), closed, "{preset:?}: {v}");
+            assert_eq!(holes(&run.samples, &mesh, &boundary), 0, "{preset:?}");
+            assert_eq!(run.stitched.holes, 0, "{preset:?}");
+            // Two triangles away from the rim and from each other: two holes.
+            let inner: Vec<usize> = (0..mesh.triangles.len())
+                .filter(|&f| {
+                    mesh.triangles[f].iter().all(|&i| {
+                        let pr = &mesh.provenance[i as usize];
+                        rim_of(&run.samples, pr) == stitch::Rim::Open
+                            && !boundary.iter().any(|&(a, b)| a == i || b == i)
+                    })
+                })
+                .collect();
+            let first = inner[0];
+            let apart = |f: usize| {
+                mesh.triangles[f]
+                    .iter()
+                    .all(|i| !mesh.triangles[first].contains(i))
+            };
+            let second = *inner.iter().rev().find(|&&f| apart(f)).expect("two apart");
+            mesh.triangles.remove(first.max(second));
+            mesh.triangles.remove(first.min(second));
+            let (_, boundary) = crate::mesh::validate_with_boundary(&mesh);
+            assert_eq!(holes(&run.samples, &mesh, &boundary), 2, "{preset:?}");
+        }
+    }
 
     /// Filed by rows, the even-odd test answers as the edge-by-edge one bit for bit, on
     /// random polygons (also self-intersecting ones, with repeated and horizontal edges) and

@@ -162,6 +162,13 @@ pub struct Stitched {
     pub removed: usize,
     /// Whether the operation budget ran out before no candidate was left.
     pub budget_hit: bool,
+    /// Boundary loops of the returned mesh with no vertex where a curve ended on a terminal
+    /// condition, at a singular point or on a budget (loops touching at a vertex count as
+    /// one): holes where the surface goes on and the mesh does not. On a surface integrable
+    /// at `p0`, fronts that met and were not stitched; on a swept surface, also where it was
+    /// cut back (its folds, or the sheet about to cross itself).
+    #[cfg_attr(feature = "serde", serde(default))]
+    pub holes: usize,
 }
 
 type EdgeMap<V> = HashMap<(u32, u32), V, FastHash>;
