@@ -151,14 +151,18 @@ impl<T> MeshRun<T> {
     }
 }
 
-/// How many times a run whose curves all ended at their first step is sampled again with
-/// shorter automatic steps (see [`SHORTER_STEPS`]).
+/// How many times a run is sampled again with shorter automatic steps (see
+/// [`SHORTER_STEPS`]): when its curves all ended at their first step, or, on a field of one's
+/// own integrable at `p0`, when some ended as at a singular point or found no chord.
 const SHORTER_STEP_RETRIES: usize = 2;
 
 /// The factor the automatic Δt, dt_min and dt_max are divided by for each such retry.
 /// A superellipsoid `|x|^4.5 + |y/1.5|^4.5 + |z/0.8|^4.5 = 1` started at the middle of its flat
 /// top face resolved Δt = 36 for a surface 3 across and laid no sample beyond `p0`; with a
-/// sixteenth it closes (7,910 triangles), with a quarter it does not.
+/// sixteenth it closes (7,910 triangles), with a quarter it does not. Started near the edge of
+/// that face, `dt_min` came out as a hundredth of its size, too long for the rounded edges:
+/// 58 curves ended there as at a singular point and a hole of 16 edges stayed; with a
+/// sixteenth it closes (8,054 triangles).
 const SHORTER_STEPS: f64 = 16.0;
 
 /// Wall-clock seconds each stage of [`run`] took.
@@ -235,10 +239,20 @@ pub fn run_observed<T: Scalar, F: NormalField<T>>(
     let mut samples = sample::sample_resolved(field, &resolved, observe)?;
     // Automatic steps sized at a flat spot (the middle of a superellipsoid's face: the
     // centres of curvature far away) can be longer than the whole surface, so that every
-    // curve ends at its first step; they are shortened and the sampling run again.
+    // curve ends at its first step, or too long for its rounded edges, where curves end as
+    // at a singular point or find no chord down to `dt_min`; they are shortened and the
+    // sampling run again. Only on a field of one's own integrable at `p0`: the model's own
+    // fields size their steps by the quadric, and a sweep or a cone does meet singular points.
     let automatic = params.dt.is_none() && params.dt_min.is_none() && params.dt_max.is_none();
+    let too_long = |samples: &sample::Samples<T>| {
+        let ends = samples.ends();
+        samples.points.len() < 3
+            || (resolved.level_correction
+                && !samples.hit_point_budget
+                && ends.singular + ends.budget > 0)
+    };
     for _ in 0..SHORTER_STEP_RETRIES {
-        if samples.points.len() >= 3 || !automatic {
+        if !automatic || !too_long(&samples) {
             break;
         }
         resolved.dt /= SHORTER_STEPS;

@@ -782,3 +782,31 @@ fn a_superellipsoid_closes_from_near_the_middle_of_its_flat_face() {
     );
     assert!(run.params.dt < 36.0 / 16.0 * 1.0001, "Δt {}", run.params.dt);
 }
+
+/// Found by `tests/user_surfaces.rs` at 256 cases (at scale 111): from near the edge of the
+/// superellipsoid's flat top face the centres of curvature lie thousands of sizes away, and
+/// the automatic `dt_min` came out as a hundredth of the surface's size, far too long for its
+/// rounded edges: 58 curves ended there as at a singular point, and the mesh kept a hole of 16
+/// edges (856 triangles). A run on a field of one's own, integrable at `p0`, whose curves end
+/// so (or find no chord down to `dt_min`) is sampled again with shorter automatic steps: it
+/// closes, with no such curve end and no hole.
+#[test]
+fn a_superellipsoid_closes_from_near_the_edge_of_its_flat_face() {
+    let p0 = [
+        0.04783858138793413,
+        -0.21710858613359926,
+        0.7999701110213291,
+    ];
+    let run = liemesh::run::<f64, _>(
+        &liemesh::model::Formula(Superellipsoid),
+        &MeshParams::at(p0),
+    )
+    .unwrap();
+    let ends = run.samples.ends();
+    assert!(
+        run.validation.is_closed() && run.validation.genus() == Some(0),
+        "{}",
+        run.validation
+    );
+    assert_eq!((ends.singular, ends.budget, run.stitched.holes), (0, 0, 0));
+}
