@@ -156,13 +156,20 @@ impl<T> MeshRun<T> {
 /// own integrable at `p0`, when some ended as at a singular point or found no chord.
 const SHORTER_STEP_RETRIES: usize = 2;
 
+/// A retry for curves that ended too soon (see [`SHORTER_STEP_RETRIES`]) may lay at most this
+/// many times the samples of the run before it. The superellipsoid below took 9 times as
+/// many; a heart-shaped surface whose field vanishes along a curve (`(x² + 9/4 y² + z² − 1)³ −
+/// x² z³ − 9/80 y² z³`), tried without this bound, crawled towards that curve for 80–145 s
+/// and 3–4 million triangles where the first run took 3–4 s.
+const SHORTER_STEP_GROWTH: usize = 16;
+
 /// The factor the automatic Δt, dt_min and dt_max are divided by for each such retry.
 /// A superellipsoid `|x|^4.5 + |y/1.5|^4.5 + |z/0.8|^4.5 = 1` started at the middle of its flat
 /// top face resolved Δt = 36 for a surface 3 across and laid no sample beyond `p0`; with a
 /// sixteenth it closes (7,910 triangles), with a quarter it does not. Started near the edge of
 /// that face, `dt_min` came out as a hundredth of its size, too long for the rounded edges:
 /// 58 curves ended there as at a singular point and a hole of 16 edges stayed; with a
-/// sixteenth it closes (8,054 triangles).
+/// sixteenth it closes (8,108 triangles).
 const SHORTER_STEPS: f64 = 16.0;
 
 /// Wall-clock seconds each stage of [`run`] took.
@@ -239,26 +246,46 @@ pub fn run_observed<T: Scalar, F: NormalField<T>>(
     let mut samples = sample::sample_resolved(field, &resolved, observe)?;
     // Automatic steps sized at a flat spot (the middle of a superellipsoid's face: the
     // centres of curvature far away) can be longer than the whole surface, so that every
-    // curve ends at its first step, or too long for its rounded edges, where curves end as
-    // at a singular point or find no chord down to `dt_min`; they are shortened and the
-    // sampling run again. Only on a field of one's own integrable at `p0`: the model's own
-    // fields size their steps by the quadric, and a sweep or a cone does meet singular points.
+    // curve ends at its first step; they are shortened and the sampling run again.
+    //
+    // On a field of one's own integrable at `p0`, they can also be too long for the surface
+    // farther on (a superellipsoid's rounded edges seen from its flat face): curves end there
+    // as at a singular point, or find no chord down to `dt_min`. Such a run is tried again
+    // with shorter steps and at most `SHORTER_STEP_GROWTH` times its samples, and the try is
+    // kept only if every curve then ends otherwise: where the field does vanish (a surface
+    // with a singular curve), shorter steps only crawl nearer to it, so the first run stays.
+    // (The model's own fields size their steps by the quadric, and a sweep or a cone does
+    // meet singular points.)
     let automatic = params.dt.is_none() && params.dt_min.is_none() && params.dt_max.is_none();
-    let too_long = |samples: &sample::Samples<T>| {
+    let ended_short = |samples: &sample::Samples<T>| {
         let ends = samples.ends();
-        samples.points.len() < 3
-            || (resolved.level_correction
-                && !samples.hit_point_budget
-                && ends.singular + ends.budget > 0)
+        ends.singular + ends.budget > 0
     };
     for _ in 0..SHORTER_STEP_RETRIES {
-        if !automatic || !too_long(&samples) {
+        let first_steps_only = samples.points.len() < 3;
+        let ends_too_soon =
+            resolved.level_correction && !samples.hit_point_budget && ended_short(&samples);
+        if !automatic || !(first_steps_only || ends_too_soon) {
             break;
         }
-        resolved.dt /= SHORTER_STEPS;
-        resolved.dt_min /= SHORTER_STEPS;
-        resolved.dt_max /= SHORTER_STEPS;
-        samples = sample::sample_resolved(field, &resolved, observe)?;
+        let mut shorter = resolved.clone();
+        shorter.dt /= SHORTER_STEPS;
+        shorter.dt_min /= SHORTER_STEPS;
+        shorter.dt_max /= SHORTER_STEPS;
+        if first_steps_only {
+            samples = sample::sample_resolved(field, &shorter, observe)?;
+            resolved = shorter;
+            continue;
+        }
+        let budget = SHORTER_STEP_GROWTH.saturating_mul(samples.points.len());
+        shorter.given.max_points = budget.min(resolved.max_points);
+        match sample::sample_resolved(field, &shorter, observe) {
+            Ok(again) if !again.hit_point_budget && !ended_short(&again) => {
+                shorter.given.max_points = resolved.max_points;
+                (resolved, samples) = (shorter, again);
+            }
+            _ => break,
+        }
     }
     let params = &resolved;
     lap(&mut timings.sampling, &mut since);

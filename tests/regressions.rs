@@ -810,3 +810,43 @@ fn a_superellipsoid_closes_from_near_the_edge_of_its_flat_face() {
     );
     assert_eq!((ends.singular, ends.budget, run.stitched.holes), (0, 0, 0));
 }
+
+/// The heart `(x² + 9/4 y² + z² − 1)³ − x² z³ − 9/80 y² z³ = 0`, whose gradient vanishes on
+/// the whole ellipse `x² + 9/4 y² = 1, z = 0` (half its gradient over 3).
+struct Heart;
+
+impl liemesh::model::FieldFormula for Heart {
+    fn normal<T: liemesh::scalar::Scalar>(&self, p: &Vec3<T>) -> Vec3<T> {
+        let c = |x: f64| T::from_f64(x);
+        let (x, y, z) = (p.x.clone(), p.y.clone(), p.z.clone());
+        let a = x.clone() * x.clone() + c(2.25) * y.clone() * y.clone() + z.clone() * z.clone()
+            - c(1.0);
+        let a2 = a.clone() * a;
+        let z2 = z.clone() * z.clone();
+        let z3 = z2.clone() * z.clone();
+        Vec3::new(
+            c(2.0) * a2.clone() * x.clone() - c(2.0 / 3.0) * x.clone() * z3.clone(),
+            c(4.5) * a2.clone() * y.clone() - c(3.0 / 40.0) * y.clone() * z3,
+            c(2.0) * a2 * z - (x.clone() * x + c(9.0 / 80.0) * y.clone() * y) * z2,
+        )
+    }
+}
+
+/// Curves on a field of one's own that end as at a singular point are sampled again with
+/// shorter steps (`a_superellipsoid_closes_from_near_the_edge_of_its_flat_face`); where the
+/// field does vanish, along the heart's rim, shorter steps only crawl nearer to it: tried
+/// without a bound, this run took 80 s and 3.9 million triangles where the first sampling gave
+/// 16,558 in 3 s. The retry may lay at most 16 times the first run's samples, and is kept only
+/// if no curve then ends so.
+#[test]
+fn a_surface_whose_field_vanishes_along_a_curve_is_not_sampled_into_millions_of_triangles() {
+    let p0 = [0.9556756175902498, 0.3185585391967499, 0.7963963479918748];
+    let run = liemesh::run::<f64, _>(&liemesh::model::Formula(Heart), &MeshParams::at(p0)).unwrap();
+    assert!(run.validation.is_valid(), "{}", run.validation);
+    assert!(run.samples.ends().singular > 0);
+    assert!(
+        run.mesh.triangles.len() < 100_000,
+        "{} triangles",
+        run.mesh.triangles.len()
+    );
+}
