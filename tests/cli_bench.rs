@@ -33,6 +33,7 @@ fn bench_json_has_keys_and_positive_numbers() {
         for key in [
             "sample_ns_per_tri",
             "triangulate_ns_per_tri",
+            "validate_ns_per_tri",
             "total_ns_per_tri",
             "spade_ns_per_tri",
             "total_over_spade",
@@ -40,6 +41,11 @@ fn bench_json_has_keys_and_positive_numbers() {
             let x = r[key].as_f64().unwrap_or(-1.0);
             assert!(x > 0.0 && x.is_finite(), "{key} = {x} in {r}");
         }
+    }
+    for r in rows {
+        // Validation is one stage of the run: less than the whole.
+        let part = r["validate_ns_per_tri"].as_f64().unwrap();
+        assert!(part < r["total_ns_per_tri"].as_f64().unwrap(), "{r}");
     }
     let fig6 = v["fig6_sampling_ms"].as_array().expect("fig6_sampling_ms");
     assert!(fig6.len() >= 3);

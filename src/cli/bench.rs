@@ -118,8 +118,11 @@ pub struct WorkloadRow {
     /// flips, closing, assembly), ns per triangle. The default mode's relaxation (with its
     /// flip pass) is not a public function, so it is timed only as part of the total.
     pub triangulate_ns_per_tri: f64,
+    /// The validation stage of the run (`MeshRun::timings.validating`: the exact validation
+    /// and anything it made undo), ns per triangle; part of the total.
+    pub validate_ns_per_tri: f64,
     /// The whole pipeline (`liemesh::run`: sampling, triangulation and, in the default mode,
-    /// relaxation), timed by itself, ns per triangle.
+    /// relaxation, then validation), timed by itself, ns per triangle.
     pub total_ns_per_tri: f64,
     /// spade's bulk load of the same chart points, ns per triangle.
     pub spade_ns_per_tri: f64,
@@ -223,6 +226,19 @@ fn targets(report: &BenchReport) -> Vec<TargetRow> {
         judge("end to end at 10^5 and 10^6, ns per triangle", ns, 350.0);
         let spd = worst(&mut report.rows.iter().filter(large).map(|r| r.total_over_spade));
         judge("end to end at 10^5 and 10^6 / spade's bulk load", spd, 1.5);
+        // Issue 15: the exact validation costs at most a quarter of the meshing time.
+        let share = worst(
+            &mut report
+                .rows
+                .iter()
+                .filter(large)
+                .map(|r| r.validate_ns_per_tri / (r.total_ns_per_tri - r.validate_ns_per_tri)),
+        );
+        judge(
+            "validation / the rest of the run at 10^5 and 10^6",
+            share,
+            0.25,
+        );
     }
     let r = &report.ratios;
     let has = |tag: &str| report.rows.iter().any(|r| r.workload.ends_with(tag));
@@ -278,6 +294,7 @@ fn time_workload(
 ) -> Result<WorkloadRow, CliError> {
     let field = LieField::<f64>::new(invariant);
     let (mut ts, mut tt, mut tb, mut te) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
+    let mut tv = Vec::new();
     let (mut triangles, mut points) = (0, 0);
     for _ in 0..repeats {
         let t5 = Instant::now();
@@ -294,19 +311,21 @@ fn time_workload(
         std::hint::black_box(dt);
         ts.push(run.timings.sampling);
         tt.push(run.timings.triangulating);
+        tv.push(run.timings.validating);
         tb.push((t4 - t3).as_secs_f64());
         te.push((t6 - t5).as_secs_f64());
         triangles = run.mesh.triangles.len();
         points = run.samples.points.len();
     }
     let per = 1e9 / triangles.max(1) as f64;
-    let [s, t, b, e] = [ts, tt, tb, te].map(|v| median(v) * per);
+    let [s, t, v, b, e] = [ts, tt, tv, tb, te].map(|v| median(v) * per);
     Ok(WorkloadRow {
         workload: name.to_string(),
         triangles,
         points,
         sample_ns_per_tri: s,
         triangulate_ns_per_tri: t,
+        validate_ns_per_tri: v,
         total_ns_per_tri: e,
         spade_ns_per_tri: b,
         total_over_spade: e / b,
@@ -489,21 +508,30 @@ pub fn run(args: &BenchArgs) -> Result<ExitCode, CliError> {
         return Ok(ExitCode::SUCCESS);
     }
     println!(
-        "{:<14} {:>9} {:>9} {:>10} {:>10} {:>10} {:>10} {:>8}",
-        "workload", "triangles", "points", "sample", "triang.", "total", "spade", "tot/spd"
+        "{:<14} {:>9} {:>9} {:>10} {:>10} {:>10} {:>10} {:>10} {:>8}",
+        "workload",
+        "triangles",
+        "points",
+        "sample",
+        "triang.",
+        "valid.",
+        "total",
+        "spade",
+        "tot/spd"
     );
     println!(
-        "{:<14} {:>9} {:>9} {:>10} {:>10} {:>10} {:>10}",
-        "", "", "", "ns/tri", "ns/tri", "ns/tri", "ns/tri"
+        "{:<14} {:>9} {:>9} {:>10} {:>10} {:>10} {:>10} {:>10}",
+        "", "", "", "ns/tri", "ns/tri", "ns/tri", "ns/tri", "ns/tri"
     );
     for r in &report.rows {
         println!(
-            "{:<14} {:>9} {:>9} {:>10.1} {:>10.1} {:>10.1} {:>10.1} {:>8.2}",
+            "{:<14} {:>9} {:>9} {:>10.1} {:>10.1} {:>10.1} {:>10.1} {:>10.1} {:>8.2}",
             r.workload,
             r.triangles,
             r.points,
             r.sample_ns_per_tri,
             r.triangulate_ns_per_tri,
+            r.validate_ns_per_tri,
             r.total_ns_per_tri,
             r.spade_ns_per_tri,
             r.total_over_spade
