@@ -480,6 +480,16 @@ pub fn check_run(
         run.mesh.triangles.len()
     );
     check_mesh(&run.mesh)?;
+    // Holes are boundary loops (loops touching at a vertex counted once): a closed mesh has
+    // none, and an open one no more than it has loops.
+    ensure!(
+        run.stitched.holes <= run.validation.boundary_loops
+            && (run.stitched.holes == 0 || !run.validation.is_closed()),
+        "{} holes reported for a mesh with {} boundary loops ({})",
+        run.stitched.holes,
+        run.validation.boundary_loops,
+        run.validation
+    );
     ensure!(
         run.vertices.len() == run.mesh.vertices.len()
             && run
