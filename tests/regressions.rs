@@ -811,6 +811,24 @@ fn a_superellipsoid_closes_from_near_the_edge_of_its_flat_face() {
     assert_eq!((ends.singular, ends.budget, run.stitched.holes), (0, 0, 0));
 }
 
+/// A run sampled again with shorter automatic steps reports the lengths it used, and the
+/// fuzz targets' check of a run accepts them (and the rest of the run): the superellipsoid
+/// from near the edge of its flat face, as above.
+#[test]
+fn a_run_with_shorter_steps_reports_them_and_passes_the_fuzz_checks() {
+    let field = liemesh::model::Formula(Superellipsoid);
+    let params = MeshParams::at([
+        0.04783858138793413,
+        -0.21710858613359926,
+        0.7999701110213291,
+    ]);
+    let resolved = params.resolve::<f64, _>(&field).expect("p0 is regular");
+    let run = liemesh::run::<f64, _>(&field, &params);
+    let used = run.as_ref().expect("the superellipsoid meshes").params.dt;
+    assert_eq!(used, resolved.dt / 16.0);
+    fuzz_checks::check_run(&field, &params, &run).unwrap();
+}
+
 /// The heart `(x² + 9/4 y² + z² − 1)³ − x² z³ − 9/80 y² z³ = 0`, whose gradient vanishes on
 /// the whole ellipse `x² + 9/4 y² = 1, z = 0` (half its gradient over 3).
 struct Heart;

@@ -1050,41 +1050,6 @@ mod tests {
     use super::*;
     use crate::geom::rng::XorShift64;
 
-    /// A run sampled again with shorter automatic steps reports the lengths it used, and the
-    /// fuzz targets' check of a run accepts them (and the rest of the run): the superellipsoid
-    /// `|x|^4.5 + |y/1.5|^4.5 + |z/0.8|^4.5 = 1` from near the edge of its flat face.
-    #[test]
-    fn a_run_with_shorter_steps_reports_them_and_passes_the_fuzz_checks() {
-        use crate::model::{FieldFormula, Formula};
-        use crate::scalar::{Scalar, Vec3};
-        struct Superellipsoid;
-        impl FieldFormula for Superellipsoid {
-            fn normal<T: Scalar>(&self, p: &Vec3<T>) -> Vec3<T> {
-                let term = |u: T, a: f64| {
-                    let u = u / T::from_f64(a);
-                    let m = u.abs().powf(2.5);
-                    T::from_f64(1.0 / a) * u * m
-                };
-                Vec3::new(
-                    term(p.x.clone(), 1.0),
-                    term(p.y.clone(), 1.5),
-                    term(p.z.clone(), 0.8),
-                )
-            }
-        }
-        let field = Formula(Superellipsoid);
-        let params = crate::MeshParams::at([
-            0.04783858138793413,
-            -0.21710858613359926,
-            0.7999701110213291,
-        ]);
-        let resolved = params.resolve::<f64, _>(&field).expect("p0 is regular");
-        let run = crate::run::<f64, _>(&field, &params);
-        let used = run.as_ref().expect("the superellipsoid meshes").params.dt;
-        assert_eq!(used, resolved.dt / 16.0);
-        crate::fuzz_checks::check_run(&field, &params, &run).unwrap();
-    }
-
     /// A hole cut into a closed sphere is a loop where the surface goes on; the rim of a disc
     /// that curves ended at the geodesic radius is not, however many edges it has.
     #[test]
