@@ -22,9 +22,12 @@
 //! offered to a chart of its own (below): refined with new points at the mesh's spacing around
 //! it (a far cap), else the loop's constrained Delaunay triangulation alone (a slit where
 //! converging curves ended side by side), each patch going in only if its triangles keep
-//! [`MIN_ANGLE_DEG`] but at the loop's own corners. A sphere's far cap traced from a pole
-//! closes so, at a fraction of the front's cost; what no chart fits (bands, seams, twisted
-//! holes) is left to the front. First, on such a field, islands go: components of at most
+//! [`MIN_ANGLE_DEG`] but at the loop's own corners (a refined patch may leave out the few,
+//! at most one in [`THIN_SHARE`], that spade's refinement leaves thin in a notch of the loop:
+//! the front closes their small holes). A loop that touches itself at a vertex is followed
+//! round the hole past it. A sphere's far cap traced from a pole closes so, at a fraction of
+//! the front's cost and with better shaped triangles; what no chart fits (bands, seams,
+//! twisted holes) is left to the front. First, on such a field, islands go: components of at most
 //! [`ISLAND`] chart triangles with no vertex on a terminal boundary, left between dropped chart
 //! triangles where many curves converge, which would force slivers between them and the rest.
 //!
@@ -160,7 +163,9 @@ pub struct Stitched {
     /// Triangles removed: around holes that were opened and stitched again, and to cut
     /// pinched vertices apart.
     pub removed: usize,
-    /// Whether the operation budget ran out before no candidate was left.
+    /// Whether the operation budget ran out before no candidate was left, leaving boundary
+    /// between fronts that met unstitched. (A round cut short whose holes the charts of the
+    /// last step then filled leaves none: the mesh is as stitched as without the budget.)
     pub budget_hit: bool,
     /// Boundary loops of the returned mesh with no vertex where a curve ended on a terminal
     /// condition, at a singular point or on a budget (loops touching at a vertex count as
@@ -407,8 +412,10 @@ pub(crate) enum Rim {
 const DEAD: [u32; 3] = [u32::MAX; 3];
 
 /// Holes left between fronts that met, of at most this many edges, are filled through a chart
-/// of their own (see [`Stitcher::fill_by_chart`]).
-const CHART_HOLE: usize = 600;
+/// of their own (see [`Stitcher::fill_by_chart`]). A sphere's far cap traced from its pole
+/// has 704 edges at 10⁵ triangles (ragged: curves converging on the far pole end at scattered
+/// distances from it) and about 1,300 at 7·10⁵.
+const CHART_HOLE: usize = 4096;
 /// A hole filled through its own chart: every corner's field normal, and every new point's,
 /// within this many degrees of the hole's mean normal (the surface there is a graph over the
 /// chart's plane).
@@ -432,6 +439,12 @@ const CHART_ATTEMPTS: usize = 4;
 /// Most chords a new point of a hole's chart is reached by (each at most the loop's mean
 /// edge length).
 const CHART_HOPS: usize = 64;
+/// A refined hole's chart may leave out at most one in this many of its triangles, those
+/// below the front's smallest angle (see [`Stitcher::fill_by_chart`]).
+const THIN_SHARE: usize = 64;
+/// A new point of a hole's chart is over its chart position to within this many hops
+/// (see [`Stitcher::lift`]).
+const LIFT_TOLERANCE: f64 = 1e-3;
 /// A hole's chart positions are multiples of this many of its mean edge length (2⁻²⁴).
 const CHART_SNAP: f64 = 1.0 / (1u32 << 24) as f64;
 /// Smallest angle spade's refinement aims for inside a hole's chart, degrees.
@@ -660,6 +673,10 @@ pub(crate) fn stitch<T: Scalar, F: NormalField<T>>(
         .edges()
         .filter(|&(a, b)| s.rim[a as usize] == Rim::Open && s.rim[b as usize] == Rim::Open)
         .count();
+    // A round cut short whose leftovers the charts then filled left nothing undone.
+    if open == 0 {
+        out.budget_hit = false;
+    }
     let Stitcher {
         pos,
         nrm,
@@ -1874,36 +1891,78 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
         added
     }
 
-    /// The simple boundary loops of at most `limit` edges none of whose vertices ended a
-    /// curve on a terminal condition: holes left where fronts met. Each loop once, in a
-    /// deterministic order.
+    /// The boundary loops of at most `limit` edges none of whose vertices ended a curve on a
+    /// terminal condition: holes left where fronts met. Each loop once, in a deterministic
+    /// order, with no vertex twice.
+    ///
+    /// Where the boundary touches itself at a vertex (two fans of triangles meeting there, as
+    /// where a ragged far cap's rim pinches), the walk goes on along the next boundary edge
+    /// counter-clockwise ([`Self::next_on_hole`]), so that the hole on either side of the
+    /// pinch is a loop of its own.
     fn open_loops(&self, limit: usize) -> Vec<Vec<u32>> {
         let edges = self.boundary_edge_list();
-        let cycle = self.boundary_cycle_lengths(&edges);
-        let mut seen: HashSet<u32, FastHash> = HashSet::default();
+        let index: HashMap<(u32, u32), usize, FastHash> =
+            edges.iter().enumerate().map(|(i, &e)| (e, i)).collect();
+        let next: Vec<Option<usize>> = edges
+            .iter()
+            .map(|&(a, b)| {
+                self.next_on_hole(a, b)
+                    .and_then(|c| index.get(&(b, c)).copied())
+            })
+            .collect();
+        // Each edge is walked once: a walk that runs into an edge walked before is no loop.
+        let mut walked = vec![false; edges.len()];
         let mut out = Vec::new();
-        for (a, b) in edges {
-            if seen.contains(&a) {
+        for start in 0..edges.len() {
+            let mut ring = Vec::new();
+            let mut e = Some(start);
+            let mut closed = false;
+            while let Some(i) = e {
+                if walked[i] {
+                    closed = i == start && !ring.is_empty();
+                    break;
+                }
+                walked[i] = true;
+                ring.push(edges[i].0);
+                e = next[i];
+            }
+            if !closed || ring.len() < 3 || ring.len() > limit {
                 continue;
             }
-            // From a vertex with one boundary edge out, the walk is its cycle's, found
-            // already: only a cycle short enough is walked (walking every edge of a long
-            // loop up to `limit` steps made this quadratic in the boundary).
-            let ring = match cycle.get(&a) {
-                Some(&len) if len > limit + 1 => None,
-                Some(_) => self.loop_from((a, b), limit),
-                None if self.boundary.outs(a).len() == 1 => None,
-                None => self.loop_from((a, b), limit),
-            };
-            let Some(ring) = ring else {
-                continue;
-            };
-            seen.extend(ring.iter().copied());
-            if ring.len() >= 3 && ring.iter().all(|&v| self.rim[v as usize] == Rim::Open) {
+            let mut distinct = ring.clone();
+            distinct.sort_unstable();
+            distinct.dedup();
+            if distinct.len() == ring.len()
+                && ring.iter().all(|&v| self.rim[v as usize] == Rim::Open)
+            {
                 out.push(ring);
             }
         }
         out
+    }
+
+    /// The end of the boundary edge that follows `from → v` round the hole on its right: the
+    /// one edge out of `v`, or where the boundary touches itself at `v`, the first out-edge
+    /// counter-clockwise about `v`'s normal from the edge back to `from` (the gap beside the
+    /// fan that `from → v` ends).
+    fn next_on_hole(&self, from: u32, v: u32) -> Option<u32> {
+        match self.boundary.outs(v) {
+            [] => None,
+            [w] => Some(*w),
+            outs => {
+                let (e1, e2) = tangent_frame(self.nrm[v as usize]);
+                let at = self.pos[v as usize];
+                let angle = |w: u32| {
+                    let d = sub(self.pos[w as usize], at);
+                    dot(d, e2).atan2(dot(d, e1))
+                };
+                let back = angle(from);
+                let turn = |w: u32| (angle(w) - back).rem_euclid(std::f64::consts::TAU);
+                outs.iter()
+                    .copied()
+                    .min_by(|&x, &y| turn(x).total_cmp(&turn(y)).then(x.cmp(&y)))
+            }
+        }
     }
 
     /// Fills the hole bounded by `ring` (a boundary loop, the hole on the right of each edge)
@@ -2103,12 +2162,32 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
                 a[k] >= floor || loop_edge(f[k], f[(k + 2) % 3]) && loop_edge(f[k], f[(k + 1) % 3])
             })
         };
+        // A refined patch may keep a few triangles below the floor beside the loop (spade
+        // cannot split the loop's edges, nor triangles below its smallest area, in a narrow
+        // notch of a ragged far cap): those are left out, and the small holes they leave are
+        // the front's.
+        let thin_allowed = match patch {
+            Patch::Refined => faces.len() / THIN_SHARE,
+            Patch::Plain => 0,
+        };
+        let mut thin = vec![false; faces.len()];
+        let mut thin_count = 0;
         let fits = lifted_ok
-            && faces.iter().zip(&triangles).all(|(&f, &t)| {
-                !t.contains(&u32::MAX)
-                    && (floor <= 0.0 || shapely(f, t))
-                    && self.patch_triangle_fits(t, n, centre, e1, e2)
-            });
+            && faces
+                .iter()
+                .zip(&triangles)
+                .zip(&mut thin)
+                .all(|((&f, &t), thin)| {
+                    if t.contains(&u32::MAX) {
+                        return false;
+                    }
+                    if floor > 0.0 && !shapely(f, t) {
+                        *thin = true;
+                        thin_count += 1;
+                        return thin_count <= thin_allowed;
+                    }
+                    self.patch_triangle_fits(t, n, centre, e1, e2)
+                });
         if !fits {
             while self.pos.len() > first_new as usize {
                 self.retract();
@@ -2119,10 +2198,16 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
             self.boundary.set_scale(v, mean_edge);
             self.points.insert(v, self.pos[v as usize]);
         }
-        for &t in &triangles {
+        let kept: Vec<[u32; 3]> = triangles
+            .iter()
+            .zip(&thin)
+            .filter(|(_, &thin)| !thin)
+            .map(|(&t, _)| t)
+            .collect();
+        for &t in &kept {
             self.add(t);
         }
-        Some((triangles.len(), self.pos.len() - first_new as usize))
+        Some((kept.len(), self.pos.len() - first_new as usize))
     }
 
     /// The median length of the edges from the corners of `ring` (a boundary loop) into the
@@ -2147,9 +2232,17 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
         Some(*lengths.select_nth_unstable_by(mid, f64::total_cmp).1)
     }
 
-    /// The point of the surface over chart point `target` (a chord from the nearest of
-    /// `corners`, in the working precision, in hops of at most `hop_length`), with its unit
-    /// field normal, if that normal is within `turn_cos` of the chart's normal `n`.
+    /// The point of the surface over chart point `target` (on the chart's plane, normal `n`),
+    /// reached by chords from the nearest of `corners` (in the working precision, in hops of
+    /// at most `hop_length`), with its unit field normal, if that normal is within
+    /// `turn_cos` of `n`.
+    ///
+    /// Distances are measured across the plane: the surface lies above or below it, by
+    /// several hops on a wide far cap, and aiming at the target itself sent the hops round
+    /// and round above it (points up to two edge lengths from where the chart put them).
+    /// A hop along the surface covers less of the plane than its length where the surface
+    /// is tilted, so the hops go on until the point is over the target to within
+    /// [`LIFT_TOLERANCE`] hop lengths.
     fn lift(
         &self,
         corners: &[u32],
@@ -2158,34 +2251,47 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
         turn_cos: f64,
         hop_length: f64,
     ) -> Option<([f64; 3], [f64; 3], Vec3<T>)> {
+        let across = |q: [f64; 3]| {
+            let d = sub(target, q);
+            let h = dot(d, n);
+            [d[0] - h * n[0], d[1] - h * n[1], d[2] - h * n[2]]
+        };
+        let reach = |q: [f64; 3]| {
+            let d = across(q);
+            dot(d, d)
+        };
         let from = *corners.iter().min_by(|&&u, &&v| {
-            dist(self.pos[u as usize], target)
-                .total_cmp(&dist(self.pos[v as usize], target))
+            reach(self.pos[u as usize])
+                .total_cmp(&reach(self.pos[v as usize]))
                 .then(u.cmp(&v))
         })?;
         // Hops of at most one local edge length: the chord's truncation error grows with the
         // fifth power of its length off cubic potentials.
         let mut point = self.work[from as usize].clone();
         let mut at = self.pos[from as usize];
+        let mut over = false;
         for _ in 0..CHART_HOPS {
-            let d = sub(target, at);
+            let d = across(at);
             let length = dot(d, d).sqrt();
-            if length.is_nan() || length <= 0.0 {
+            if length.is_nan() {
                 return None;
             }
-            let hop = length.min(hop_length);
+            if length <= LIFT_TOLERANCE * hop_length {
+                over = true;
+                break;
+            }
             point = trace::step_fixed(
                 self.growth.field,
                 &self.growth.cfg,
                 &point,
                 &Vec3::<T>::from_f64(d),
-                &T::from_f64(hop),
+                &T::from_f64(length.min(hop_length)),
             )
             .ok()?;
             at = point.to_f64();
-            if hop == length {
-                break;
-            }
+        }
+        if !over {
+            return None;
         }
         let (_, normal, _) = trace::unit_normal(self.growth.field, &point).ok()?;
         let (q, normal) = (point.to_f64(), normal.to_f64());
@@ -2239,53 +2345,6 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
         ring.iter()
             .filter(|v| !t.contains(v))
             .all(|&v| point_triangle_distance(self.pos[v as usize], c) > EAR_CLEARANCE * size)
-    }
-
-    /// The length of the boundary cycle through each vertex that lies on one made only of
-    /// vertices with a single boundary edge out (the successor graph's cycles, each found
-    /// once). A vertex with one edge out that is on no such cycle has no entry; from it,
-    /// [`Self::loop_from`] fails, and from one on a cycle it returns that cycle if it is
-    /// short enough.
-    fn boundary_cycle_lengths(&self, edges: &[(u32, u32)]) -> HashMap<u32, usize, FastHash> {
-        let next = |v: u32| match self.boundary.outs(v) {
-            [w] => Some(*w),
-            _ => None,
-        };
-        // 1: on the path being followed, 2: done.
-        let mut state: HashMap<u32, u8, FastHash> = HashMap::default();
-        let mut cycle: HashMap<u32, usize, FastHash> = HashMap::default();
-        let mut path = Vec::new();
-        for &(a, _) in edges {
-            if state.contains_key(&a) {
-                continue;
-            }
-            path.clear();
-            let mut v = a;
-            let end = loop {
-                match state.get(&v) {
-                    Some(_) => break Some(v),
-                    None => {
-                        state.insert(v, 1);
-                        path.push(v);
-                        match next(v) {
-                            Some(w) => v = w,
-                            None => break None,
-                        }
-                    }
-                }
-            };
-            if let Some(v) = end.filter(|v| state[v] == 1) {
-                let at = path.iter().position(|&x| x == v).expect("on the path");
-                let len = path.len() - at;
-                for &x in &path[at..] {
-                    cycle.insert(x, len);
-                }
-            }
-            for &x in &path {
-                state.insert(x, 2);
-            }
-        }
-        cycle
     }
 
     /// The boundary loop through edge `a → b`, if it is a simple loop (no pinched vertex on
