@@ -390,7 +390,7 @@ pub fn run_observed<T: Scalar, F: NormalField<T>>(
     }
     untangled.pinned = pinned;
     let mut stitched = stitched;
-    stitched.holes = triangulate::holes(&samples, &mesh, &boundary);
+    stitched.holes = triangulate::holes(&samples, params, &mesh, &boundary);
     triangulate::drop_unused(&mut mesh, &mut vertices);
     // The refinement's count of faces over the bound, on the mesh as returned.
     let mut refinement = refinement;

@@ -917,3 +917,28 @@ fn assert_far_cap_charted(growth: f64, new_points: usize, min_angle: f64) {
     let (worst, _) = liemesh::quality::face_normal_error(&field, &run.mesh);
     assert!(worst < 1.0, "face-normal error {worst}°");
 }
+
+/// Found by `tests/classes.rs` at `PROPTEST_RNG_SEED=777`: a tilted elliptic cylinder came out
+/// a band (χ = 0, two loops, both at the bounding box) but one end was reported as a hole.
+/// Its vertices belonged to curves that merged beside the box: the ends of the curves that
+/// reached the box had gone with triangles the validation dropped. A boundary vertex within
+/// its longest boundary edge of the box (or of the geodesic radius) is on the rim too.
+#[test]
+fn a_bands_end_at_the_bounding_box_is_no_hole() {
+    let numbers = [
+        0.5031942545763227,
+        0.0,
+        0.04012170934036693,
+        1.0518477739018426,
+        -1.3509066063804709,
+        -2.467483042013092,
+    ];
+    let invariant = Invariant::from_numbers(&numbers)
+        .unwrap()
+        .with_reading(liemesh::model::AngleReading::Quadric);
+    let p0 = [2.3375931613882996, -0.9396169197918688, 0.8179670760277526];
+    let run = liemesh::run(&LieField::<f64>::new(&invariant), &MeshParams::at(p0)).unwrap();
+    let v = &run.validation;
+    assert!(v.euler_characteristic == 0 && v.boundary_loops == 2, "{v}");
+    assert_eq!(run.stitched.holes, 0, "{:?}", run.stitched);
+}

@@ -183,7 +183,18 @@ fn rim_of<T>(samples: &Samples<T>, pr: &Provenance) -> stitch::Rim {
 
 /// How many loops of `boundary`'s edges (vertex pairs of `mesh`; loops that touch at a vertex
 /// count as one) have no vertex on the surface's own rim (see [`Stitched::holes`]).
-pub(crate) fn holes<T>(samples: &Samples<T>, mesh: &Mesh, boundary: &[(u32, u32)]) -> usize {
+///
+/// A vertex is on the rim where a curve ended on a terminal condition, at a singular point or
+/// on a budget, and also where it lies within its longest boundary edge of the bounding box or
+/// of the geodesic radius (`params`): the end of a curve that reached them may have gone with
+/// the triangles the validation dropped, leaving a band's end (a cylinder's, at the box) lined
+/// with vertices of curves that merged there.
+pub(crate) fn holes<T>(
+    samples: &Samples<T>,
+    params: &Resolved,
+    mesh: &Mesh,
+    boundary: &[(u32, u32)],
+) -> usize {
     if boundary.is_empty() {
         return 0;
     }
@@ -196,15 +207,30 @@ pub(crate) fn holes<T>(samples: &Samples<T>, mesh: &Mesh, boundary: &[(u32, u32)
     for &(a, b) in boundary {
         loops.union(index(a), index(b));
     }
+    // Each boundary vertex's longest boundary edge.
+    let mut reach = vec![0.0f64; ends.len()];
+    for &(a, b) in boundary {
+        let length = match (mesh.vertices.get(a as usize), mesh.vertices.get(b as usize)) {
+            (Some(&p), Some(&q)) => dist3(p, q),
+            _ => 0.0,
+        };
+        for v in [a, b] {
+            let k = index(v) as usize;
+            reach[k] = reach[k].max(length);
+        }
+    }
     // A loop is on the rim if any of its vertices is.
     let mut on_rim = vec![false; ends.len()];
     for (k, &v) in ends.iter().enumerate() {
-        let rim = mesh
-            .provenance
+        let ended = mesh.provenance.get(v as usize).is_some_and(|pr| {
+            rim_of(samples, pr) != stitch::Rim::Open || pr.s >= params.max_radius - reach[k]
+        });
+        let at_box = mesh
+            .vertices
             .get(v as usize)
-            .is_some_and(|pr| rim_of(samples, pr) != stitch::Rim::Open);
+            .is_some_and(|q| q.iter().any(|x| x.abs() >= params.bounding_box - reach[k]));
         let root = loops.find(k as u32) as usize;
-        on_rim[root] |= rim;
+        on_rim[root] |= ended || at_box;
     }
     (0..ends.len() as u32)
         .filter(|&k| loops.find(k) == k && !on_rim[k as usize])
@@ -1061,15 +1087,25 @@ mod tests {
             let mut mesh = run.mesh.clone();
             let (v, boundary) = crate::mesh::validate_with_boundary(&mesh);
             assert_eq!(v.is_closed(), closed, "{preset:?}: {v}");
-            assert_eq!(holes(&run.samples, &mesh, &boundary), 0, "{preset:?}");
+            assert_eq!(
+                holes(&run.samples, &run.params, &mesh, &boundary),
+                0,
+                "{preset:?}"
+            );
             assert_eq!(run.stitched.holes, 0, "{preset:?}");
-            // Two triangles away from the rim and from each other: two holes.
+            // Two triangles away from the rim (well inside the radius and the box) and from
+            // each other: two holes.
+            let (radius, box_size) = (run.params.max_radius, run.params.bounding_box);
             let inner: Vec<usize> = (0..mesh.triangles.len())
                 .filter(|&f| {
                     mesh.triangles[f].iter().all(|&i| {
                         let pr = &mesh.provenance[i as usize];
                         rim_of(&run.samples, pr) == stitch::Rim::Open
                             && !boundary.iter().any(|&(a, b)| a == i || b == i)
+                            && pr.s < 0.5 * radius
+                            && mesh.vertices[i as usize]
+                                .iter()
+                                .all(|x| x.abs() < 0.5 * box_size)
                     })
                 })
                 .collect();
@@ -1083,7 +1119,11 @@ mod tests {
             mesh.triangles.remove(first.max(second));
             mesh.triangles.remove(first.min(second));
             let (_, boundary) = crate::mesh::validate_with_boundary(&mesh);
-            assert_eq!(holes(&run.samples, &mesh, &boundary), 2, "{preset:?}");
+            assert_eq!(
+                holes(&run.samples, &run.params, &mesh, &boundary),
+                2,
+                "{preset:?}"
+            );
         }
     }
 
