@@ -27,9 +27,10 @@
 //! the front closes their small holes). A loop that touches itself at a vertex is followed
 //! round the hole past it. A sphere's far cap traced from a pole closes so, at a fraction of
 //! the front's cost and with better shaped triangles; what no chart fits (bands, seams,
-//! twisted holes) is left to the front. First, on such a field, islands go: components of at most
-//! [`ISLAND`] chart triangles with no vertex on a terminal boundary, left between dropped chart
-//! triangles where many curves converge, which would force slivers between them and the rest.
+//! twisted holes) is left to the front. First, on such a field, islands go: components of at
+//! most [`ISLAND`] chart triangles with no vertex on a terminal boundary, left between dropped
+//! chart triangles where many curves converge, which would force slivers between them and the
+//! rest.
 //!
 //! A new point of the front is placed where the triangle on its edge would be equilateral,
 //! reached from the edge's first end by two half chords: where the potential is not cubic a
@@ -168,11 +169,11 @@ pub struct Stitched {
     /// last step then filled leaves none: the mesh is as stitched as without the budget.)
     pub budget_hit: bool,
     /// Boundary loops of the returned mesh with no vertex where a curve ended on a terminal
-    /// condition, at a singular point or on a budget, nor within a longest step of the
-    /// bounding box or the geodesic radius (loops touching at a vertex count as one): holes
-    /// where the surface goes on and the mesh does not. On a surface integrable
-    /// at `p0`, fronts that met and were not stitched; on a swept surface, also where it was
-    /// cut back (its folds, or the sheet about to cross itself).
+    /// condition, at a singular point or on a budget, nor within its longest boundary edge of
+    /// the bounding box or the geodesic radius (loops touching at a vertex count as one):
+    /// holes where the surface goes on and the mesh does not. On a surface integrable at
+    /// `p0`, fronts that met and were not stitched; on a swept surface, also where it was cut
+    /// back (its folds, or the sheet about to cross itself).
     #[cfg_attr(feature = "serde", serde(default))]
     pub holes: usize,
 }
