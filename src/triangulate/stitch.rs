@@ -2200,16 +2200,13 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
             self.boundary.set_scale(v, mean_edge);
             self.points.insert(v, self.pos[v as usize]);
         }
-        let kept: Vec<[u32; 3]> = triangles
-            .iter()
-            .zip(&thin)
-            .filter(|(_, &thin)| !thin)
-            .map(|(&t, _)| t)
-            .collect();
-        for &t in &kept {
+        for (&t, _) in triangles.iter().zip(&thin).filter(|(_, &thin)| !thin) {
             self.add(t);
         }
-        Some((kept.len(), self.pos.len() - first_new as usize))
+        Some((
+            faces.len() - thin_count,
+            self.pos.len() - first_new as usize,
+        ))
     }
 
     /// The median length of the edges from the corners of `ring` (a boundary loop) into the
