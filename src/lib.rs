@@ -126,8 +126,9 @@ impl<T> MeshRun<T> {
         if ends.budget > 0 && !self.samples.hit_point_budget {
             why.push(format!(
                 "{} curve{} ended on a budget (max_steps = {} steps per curve, or no chord \
-                 within max_retries = {} Newton iterations at any step down to dt_min = {:.3e}, \
-                 where the surface bends more sharply than that step can follow)",
+                 within max_retries = {} Newton iterations, or no step down to dt_min = {:.3e} \
+                 short enough to follow how sharply the surface bends; a smaller dt_min lets \
+                 them go on)",
                 ends.budget,
                 if ends.budget == 1 { "" } else { "s" },
                 p.max_steps,

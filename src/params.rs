@@ -366,10 +366,12 @@ const AUTO_DT_MIN_SWEPT: f64 = AUTO_DT / 10.0;
 const SWEPT_DT_MIN_OF_EXTENT: f64 = 4e-3;
 const AUTO_DT_MAX: f64 = 0.5;
 /// The flattest ellipsoid (longest over shortest semi-axis) whose automatic step clamps are
-/// fitted to the whole surface (see [`MeshParams::resolve`]): measured, 1:1:0.071 (`λ` up to
-/// 1:1:200) closes from its pole and from a generic point in 2.3 s; 1:1:0.032 (`λ` 1:1:1000)
-/// ran 23–44 s and stayed open.
-const FITTED_FLATNESS: f64 = 16.0;
+/// fitted to the whole surface (see [`MeshParams::resolve`]): measured, 1:1:0.05 (`λ`
+/// 1:1:400) closes from its pole and from generic points (0.5 million triangles, 4–11 s);
+/// 1:1:0.04 (`λ` 1:1:625) from its pole ran 54 s into the stitching budget and stayed open,
+/// and 1:1:0.032 (`λ` 1:1:1000) 23–44 s. Flatter ones keep the clamps of `p0`: their curves
+/// stop at the rim on the step floor, and the run says it was cut short.
+const FITTED_FLATNESS: f64 = 20.5;
 const AUTO_RADIUS: f64 = 4.0 * std::f64::consts::PI;
 /// The automatic geodesic radius on a non-integrable field, of the extent scale: a
 /// hemisphere's. No surface has such a normal field; the surface the curves sweep folds onto
@@ -430,7 +432,7 @@ impl MeshParams {
         // rim's radius `shortest² / longest` (the shape at `p0`, a flat pole, tells neither).
         // Only up to FITTED_FLATNESS: flatter ones, meshed with isotropic triangles small
         // enough for the rim, run for tens of seconds into the stitching budget; they keep
-        // the clamps of `p0` and end in an error that names `dt_max`.
+        // the clamps of `p0` and end in an error that names `dt_max`, or cut short.
         let (thickness, sharpest) = field
             .semi_axes_through(self.p0)
             .filter(|[s0, _, s2]| *s2 <= FITTED_FLATNESS * *s0)

@@ -487,6 +487,29 @@ fn a_flattened_ellipsoid_closes_from_its_pole_and_from_a_generic_point_with_defa
     }
 }
 
+/// A 25:1 oblate ellipsoid (`λ` = 1, 1, 625, flatter than the automatic clamps are fitted
+/// to) from generic points, with defaults: the rim bends more sharply (radius 0.0016) than
+/// the automatic `dt_min` (about 0.025) can follow. The curves stopped there "at a singular
+/// point" and the run came out as a small open disc (230–388 triangles) with nothing saying it
+/// was cut short; an ellipsoid has no singular point, so they now end on the step floor and
+/// the run says so. (Up to 20:1, `λ` = 1, 1, 400, the clamps fit the rim and it closes.)
+#[test]
+fn an_ellipsoid_too_flat_for_the_automatic_steps_says_it_was_cut_short() {
+    let flat = Invariant::from_numbers(&[1.0, 1.0, 625.0, 0.0, 0.0, 0.0]).unwrap();
+    let field = LieField::<f64>::new(&flat);
+    for d in [[1.0_f64, 1.0, 1.0], [0.3, 0.5, 0.8], [0.7, 0.1, 0.3]] {
+        let level = (d[0] * d[0] + d[1] * d[1] + 625.0 * d[2] * d[2]).sqrt();
+        let run = liemesh::run(&field, &MeshParams::at(d.map(|x| x / level))).unwrap();
+        let ends = run.samples.ends();
+        assert_eq!(ends.singular, 0, "{d:?}");
+        if !run.validation.is_closed() {
+            assert!(ends.budget > 0, "{d:?}: {ends:?}");
+            let why = run.cut_short().join("; ");
+            assert!(why.contains("smaller dt_min"), "{d:?}: {why}");
+        }
+    }
+}
+
 /// A 10:1 oblate ellipsoid (`λ` = 1, 1, 100) from a point of its rim, with defaults: closed,
 /// χ = 2. The rim bends with radius 0.01, sharper than the triangles (about 0.05) can follow,
 /// and the fronts that meet there left two holes of one triangle each, twisted across the rim

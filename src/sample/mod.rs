@@ -38,8 +38,10 @@ pub enum CurveEnd {
     Merge,
     /// Met a singular point (vanishing normal, no tangent direction, non-finite value).
     Singular,
-    /// A budget ran out: points, steps per curve, or Newton's iterations for a chord at
-    /// every length tried ([`StepStop::NoChord`](crate::trace::StepStop::NoChord)).
+    /// A budget ran out: points, steps per curve, Newton's iterations for a chord at every
+    /// length tried ([`StepStop::NoChord`](crate::trace::StepStop::NoChord)), or the step
+    /// floor `dt_min` on a surface known to have no singular point (an ellipsoid's rim bending
+    /// more sharply than that step can follow).
     Budget,
 }
 
@@ -318,6 +320,7 @@ pub(crate) fn sample_resolved<T: Scalar, F: NormalField<T>>(
             hit_point_budget: false,
         },
         pos: vec![params.p0],
+        smooth: field.semi_axes_through(params.p0).is_some(),
         nrm: vec![n0.to_f64()],
         chart: vec![[0.0, 0.0]],
         live: Vec::new(),
@@ -394,6 +397,10 @@ struct Sampler<'a, T, F> {
     max_drift: f64,
     /// Where progress is reported (every [`SAMPLING_REPORT_EVERY`] passes of [`Self::run`]).
     observe: &'a dyn Fn(Progress),
+    /// Whether the field knows its surface has no singular point (an ellipsoid's,
+    /// [`NormalField::semi_axes_through`]): a step that cannot follow the bend at `dt_min`
+    /// then ends its curve on the step floor ([`CurveEnd::Budget`]), not at a singular point.
+    smooth: bool,
 }
 
 impl<T: Scalar, F: NormalField<T>> Sampler<'_, T, F> {
@@ -469,12 +476,18 @@ impl<T: Scalar, F: NormalField<T>> Sampler<'_, T, F> {
         let q = step.point.to_f64();
         // A step clamped at the smallest length that still turns the normal by more than
         // twice the band's top is at a singular point (a cone's apex): the field's curvature
-        // grows without bound there, and the next step would jump across it.
+        // grows without bound there, and the next step would jump across it. On a surface
+        // known to have none (an ellipsoid flatter than the fitted clamps), it is a rim
+        // sharper than `dt_min` resolves: the step floor ended the curve, and the run says so.
         if step.limit == StepLimit::Clamped
             && len <= self.params.dt_min * (1.0 + 1e-9)
             && step.alpha_predicted > SINGULAR_TURN * self.params.beta_max.radians()
         {
-            return Some(CurveEnd::Singular);
+            return Some(if self.smooth {
+                CurveEnd::Budget
+            } else {
+                CurveEnd::Singular
+            });
         }
         let s_new = live.s + len;
         if s_new > self.params.max_radius {
