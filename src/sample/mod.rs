@@ -635,7 +635,13 @@ impl<T: Scalar, F: NormalField<T>> Sampler<'_, T, F> {
                 return false;
             }
             let d = d2.sqrt();
-            let near = match normal {
+            // Far in the chart first: most points this near are not.
+            let cj = self.chart[j as usize];
+            let dc = ((cj[0] - chart_q[0]).powi(2) + (cj[1] - chart_q[1]).powi(2)).sqrt();
+            if dc <= 2.0 * d + len {
+                return false;
+            }
+            match normal {
                 None => d < radius,
                 Some(n) => {
                     let along = dot(e, n);
@@ -646,11 +652,6 @@ impl<T: Scalar, F: NormalField<T>> Sampler<'_, T, F> {
                         && across < radius
                         && along.abs() < radius + drift_q + self.drift[j as usize]
                 }
-            };
-            near && {
-                let cj = self.chart[j as usize];
-                let dc = ((cj[0] - chart_q[0]).powi(2) + (cj[1] - chart_q[1]).powi(2)).sqrt();
-                dc > 2.0 * d + len
             }
         })
     }
@@ -690,6 +691,13 @@ impl<T: Scalar, F: NormalField<T>> Sampler<'_, T, F> {
             if dq > limit {
                 return false;
             }
+            // Far in the chart: not this curve's own recent points nor its neighbours' (most
+            // of the points this near, so this test goes first).
+            let cj = self.chart[j];
+            let dc = ((cj[0] - chart_q[0]).powi(2) + (cj[1] - chart_q[1]).powi(2)).sqrt();
+            if dc <= 2.0 * dq + 2.0 * len {
+                return false;
+            }
             let nj = self.nrm[j];
             let (sp, sq) = (dot(sub(p, xj), nj), dot(sub(q, xj), nj));
             let radius = match beside {
@@ -697,17 +705,14 @@ impl<T: Scalar, F: NormalField<T>> Sampler<'_, T, F> {
                 _ => radius,
             };
             let onto = sq.abs() < thickness && dq < radius;
-            let through = ((sp > 0.0 && sq < 0.0) || (sp < 0.0 && sq > 0.0)) && {
-                let t = sp / (sp - sq);
-                let c = [p[0] + t * e[0], p[1] + t * e[1], p[2] + t * e[2]];
-                dist(c, xj) < radius
+            let through = || {
+                ((sp > 0.0 && sq < 0.0) || (sp < 0.0 && sq > 0.0)) && {
+                    let t = sp / (sp - sq);
+                    let c = [p[0] + t * e[0], p[1] + t * e[1], p[2] + t * e[2]];
+                    dist(c, xj) < radius
+                }
             };
-            // Far in the chart: not this curve's own recent points nor its neighbours'.
-            (onto || through) && {
-                let cj = self.chart[j];
-                let dc = ((cj[0] - chart_q[0]).powi(2) + (cj[1] - chart_q[1]).powi(2)).sqrt();
-                dc > 2.0 * dq + 2.0 * len
-            }
+            onto || through()
         })
     }
 

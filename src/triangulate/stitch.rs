@@ -2134,12 +2134,22 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
             .sum::<f64>()
             / m as f64;
         let mut lifted_ok = true;
+        let mut near: Vec<u32> = Vec::new();
         for &i in &steiner {
-            let p2 = cdt
-                .vertex(spade::handles::FixedVertexHandle::from_index(i))
-                .position();
+            let vertex = cdt.vertex(spade::handles::FixedVertexHandle::from_index(i));
+            let p2 = vertex.position();
             let target = [0, 1, 2].map(|k| centre[k] + mean_edge * (p2.x * e1[k] + p2.y * e2[k]));
-            let Some(point) = self.lift(ids.as_slice(), target, n, turn_cos, mean_edge) else {
+            // Hops start from the nearest neighbour in the chart already on the surface (a
+            // corner, or a point lifted before): about one hop away. Only a point whose
+            // neighbours all come later starts from the nearest corner of the loop.
+            near.clear();
+            near.extend(
+                vertex
+                    .out_edges()
+                    .filter_map(|e| index.get(&e.to().fix().index()).copied()),
+            );
+            let from = if near.is_empty() { &ids } else { &near };
+            let Some(point) = self.lift(from, target, n, turn_cos, mean_edge) else {
                 lifted_ok = false;
                 break;
             };
@@ -2232,7 +2242,7 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
     }
 
     /// The point of the surface over chart point `target` (on the chart's plane, normal `n`),
-    /// reached by chords from the nearest of `corners` (in the working precision, in hops of
+    /// reached by chords from the nearest of the vertices `starts` (in the working precision, in hops of
     /// at most `hop_length`), with its unit field normal, if that normal is within
     /// `turn_cos` of `n`.
     ///
@@ -2244,7 +2254,7 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
     /// [`LIFT_TOLERANCE`] hop lengths.
     fn lift(
         &self,
-        corners: &[u32],
+        starts: &[u32],
         target: [f64; 3],
         n: [f64; 3],
         turn_cos: f64,
@@ -2259,7 +2269,7 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
             let d = across(q);
             dot(d, d)
         };
-        let from = *corners.iter().min_by(|&&u, &&v| {
+        let from = *starts.iter().min_by(|&&u, &&v| {
             reach(self.pos[u as usize])
                 .total_cmp(&reach(self.pos[v as usize]))
                 .then(u.cmp(&v))
