@@ -531,6 +531,18 @@ fn a_ten_to_one_oblate_ellipsoid_with_unequal_axes_closes_from_its_rim() {
     assert_closes_from_rim([1.0, 2.0, 100.0]);
 }
 
+/// A 1 : 0.22 : 0.05 ellipsoid (`λ` = 1, 20, 400) from the tip of its longest axis, with
+/// defaults: closed, χ = 2. The fronts meet at the other tip, whose sharpest radius (0.0025)
+/// is a twentieth of the triangles there; they left a loop of six edges whose corners' normals
+/// point up to 120° apart, which no ear, fan or chart could close under the tilt limit, and the
+/// run ended open (104,256 triangles, one hole). On an ellipsoid such a loop bounds a disc,
+/// and it is now closed by the best-shaped of its triangulations whose triangles face the way
+/// their corners' normals do and meet nothing.
+#[test]
+fn a_triaxial_ellipsoid_closes_at_its_far_sharp_tip() {
+    assert_closes_from_rim([1.0, 20.0, 400.0]);
+}
+
 /// The ellipsoid `λ · x² = 1`, meshed with defaults from `(1, 0, 0)` on its rim (`λ[0]` = 1),
 /// is closed with χ = 2 and not cut short.
 fn assert_closes_from_rim(lambda: [f64; 3]) {

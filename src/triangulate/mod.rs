@@ -265,6 +265,7 @@ pub(crate) fn stitch<T: Scalar, F: NormalField<T>>(
         max_vertices: params.max_points,
         new_points: integrable,
         well_shaped: true,
+        ovaloid: field.semi_axes_through(params.p0).is_some(),
     };
     let (mut stitched, mut open) = stitch::stitch(mesh, vertices, &rim, &[], &growth);
     if open == 0 || !integrable {

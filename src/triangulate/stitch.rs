@@ -105,6 +105,9 @@ pub(crate) const REACH: f64 = 2.2;
 pub(crate) const SMALL_HOLE: usize = 12;
 /// The longest loop left after ear clipping that is filled by a fan around a new point.
 const FAN_HOLE: usize = 6;
+/// The longest loop left after ear clipping and fans that may be closed by triangles across
+/// a bend sharper than they are ([`Stitcher::bent_triangulation`]).
+const BENT_HOLE: usize = 8;
 /// A triangle with an angle below this many degrees closing a small hole is a sliver whose
 /// normal is not tested.
 const SLIVER_DEG: f64 = 3.0;
@@ -519,6 +522,12 @@ pub(crate) struct Growth<'f, T, F> {
     /// triangle down to [`MIN_ANGLE_DEG`] competes from the start (the fallback where the
     /// well-shaped seam leaves fronts unstitched).
     pub(crate) well_shaped: bool,
+    /// Whether the surface is known to be an ovaloid (closed and convex: an ellipsoid,
+    /// [`NormalField::semi_axes_through`]), on which every hole left between fronts bounds a
+    /// disc, so that a small one may be closed across a bend sharper than its triangles
+    /// ([`Stitcher::bent_triangulation`]). Elsewhere a small loop can ring a whole missing
+    /// handle (a tanglecube's), which a disc across it would close off.
+    pub(crate) ovaloid: bool,
 }
 
 /// Stitches the boundary of `mesh` (triangles counter-clockwise about the field normals) to
@@ -1745,6 +1754,72 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
             .then_some(t)
     }
 
+    /// The triangulation of loop `ring` (of at most [`BENT_HOLE`] edges) whose smallest angle
+    /// is largest among those whose every triangle faces the same side as the field normal
+    /// at each of its corners (however far it tilts), covers no other vertex of the loop and
+    /// meets nothing, nor the others; `None` if there is none. (Dynamic programming over the
+    /// loop's sub-polygons: each triangle is tested once.)
+    fn bent_triangulation(&self, ring: &[u32]) -> Option<Vec<[u32; 3]>> {
+        let m = ring.len();
+        if !(3..=BENT_HOLE).contains(&m) {
+            return None;
+        }
+        // Triangle (i, j, k), i < j < k along the loop, oriented as an ear is.
+        let tri = |i: usize, j: usize, k: usize| [ring[k], ring[j], ring[i]];
+        let smallest = |t: [u32; 3]| -> Option<f64> {
+            let c = corners(&self.pos, t);
+            let face = cross(sub(c[1], c[0]), sub(c[2], c[0]));
+            (t.iter().all(|&x| dot(face, self.nrm[x as usize]) > 0.0)
+                && self.covers_none(ring, t)
+                && self.face_meets_nothing(t))
+            .then(|| angles(c).into_iter().fold(f64::INFINITY, f64::min))
+        };
+        // best[i][k]: the best smallest angle of the sub-polygon i..=k, and its apex on i–k.
+        let mut best = vec![vec![None::<(f64, usize)>; m]; m];
+        for span in 2..m {
+            for i in 0..m - span {
+                let k = i + span;
+                for j in i + 1..k {
+                    let side = |a: usize, b: usize| {
+                        if b == a + 1 {
+                            Some(f64::INFINITY)
+                        } else {
+                            best[a][b].map(|(s, _)| s)
+                        }
+                    };
+                    let (Some(left), Some(right)) = (side(i, j), side(j, k)) else {
+                        continue;
+                    };
+                    let Some(here) = smallest(tri(i, j, k)) else {
+                        continue;
+                    };
+                    let score = here.min(left).min(right);
+                    if best[i][k].is_none_or(|(s, _)| score > s) {
+                        best[i][k] = Some((score, j));
+                    }
+                }
+            }
+        }
+        let mut out = Vec::with_capacity(m - 2);
+        let mut stack = vec![(0, m - 1)];
+        while let Some((i, k)) = stack.pop() {
+            if k < i + 2 {
+                continue;
+            }
+            let (_, j) = best[i][k]?;
+            out.push(tri(i, j, k));
+            stack.push((i, j));
+            stack.push((j, k));
+        }
+        // The triangles were tested against the mesh, not against one another.
+        let apart = out.iter().enumerate().all(|(a, &f)| {
+            out[a + 1..]
+                .iter()
+                .all(|&g| !faces_intersect(&self.pos, f, g))
+        });
+        apart.then_some(out)
+    }
+
     /// Closes the boundary loops that are left, ear by ear (the best-shaped ear first), as
     /// long as the ears face the way the field does, meet nothing and cover no other vertex of
     /// the loop: the last few triangles where fronts met may have to be thin. Loops of at most
@@ -1789,6 +1864,17 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
                         // however far it tilts.
                         self.add(t);
                         added += 1;
+                    } else if let Some(ts) = (m > 3 && self.growth.ovaloid)
+                        .then(|| self.bent_triangulation(&ring))
+                        .flatten()
+                    {
+                        // A few missing triangles across such a bend (the far tip of a
+                        // 1:0.22:0.05 ellipsoid meshed from the other tip): the same test,
+                        // for the best-shaped of the loop's triangulations that passes it.
+                        added += ts.len();
+                        for t in ts {
+                            self.add(t);
+                        }
                     }
                     break;
                 };
@@ -1845,6 +1931,7 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
         });
         self.push_vertex(q, normal, s + length, theta, point);
         let n = ring.len();
+        let fan = |i: usize| [ring[(i + 1) % n], ring[i], x];
         let fits = (0..n).all(|i| {
             let (a, b) = (ring[i], ring[(i + 1) % n]);
             self.score(a, b, x, f64::INFINITY, 0.0).is_some() && self.meets_nothing(a, b, x)
@@ -1855,7 +1942,7 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
         }
         self.register(x, ring[0], ring[1]);
         for i in 0..n {
-            self.add([ring[(i + 1) % n], ring[i], x]);
+            self.add(fan(i));
         }
         true
     }
