@@ -320,7 +320,7 @@ pub(crate) fn sample_resolved<T: Scalar, F: NormalField<T>>(
             hit_point_budget: false,
         },
         pos: vec![params.p0],
-        smooth: field.semi_axes_through(params.p0).is_some(),
+        no_singular_point: field.semi_axes_through(params.p0).is_some(),
         nrm: vec![n0.to_f64()],
         chart: vec![[0.0, 0.0]],
         live: Vec::new(),
@@ -400,7 +400,7 @@ struct Sampler<'a, T, F> {
     /// Whether the field knows its surface has no singular point (an ellipsoid's,
     /// [`NormalField::semi_axes_through`]): a step that cannot follow the bend at `dt_min`
     /// then ends its curve on the step floor ([`CurveEnd::Budget`]), not at a singular point.
-    smooth: bool,
+    no_singular_point: bool,
 }
 
 impl<T: Scalar, F: NormalField<T>> Sampler<'_, T, F> {
@@ -483,7 +483,7 @@ impl<T: Scalar, F: NormalField<T>> Sampler<'_, T, F> {
             && len <= self.params.dt_min * (1.0 + 1e-9)
             && step.alpha_predicted > SINGULAR_TURN * self.params.beta_max.radians()
         {
-            return Some(if self.smooth {
+            return Some(if self.no_singular_point {
                 CurveEnd::Budget
             } else {
                 CurveEnd::Singular

@@ -1748,10 +1748,16 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
     /// field normal at each of its corners (however far it tilts) and meets nothing.
     fn last_triangle(&self, ring: &[u32]) -> Option<[u32; 3]> {
         let t = [ring[2], ring[1], ring[0]];
+        self.fits_across_bend(t).then_some(t)
+    }
+
+    /// Whether triangle `t` faces the same side as the field normal at each of its corners
+    /// (however far it tilts) and meets nothing: the test of the triangles that close a hole
+    /// across a bend sharper than they are.
+    fn fits_across_bend(&self, t: [u32; 3]) -> bool {
         let [pa, pb, pc] = corners(&self.pos, t);
         let face = cross(sub(pb, pa), sub(pc, pa));
-        (t.iter().all(|&v| dot(face, self.nrm[v as usize]) > 0.0) && self.face_meets_nothing(t))
-            .then_some(t)
+        t.iter().all(|&v| dot(face, self.nrm[v as usize]) > 0.0) && self.face_meets_nothing(t)
     }
 
     /// The triangulation of loop `ring` (of at most [`BENT_HOLE`] edges) whose smallest angle
@@ -1767,12 +1773,11 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
         // Triangle (i, j, k), i < j < k along the loop, oriented as an ear is.
         let tri = |i: usize, j: usize, k: usize| [ring[k], ring[j], ring[i]];
         let smallest = |t: [u32; 3]| -> Option<f64> {
-            let c = corners(&self.pos, t);
-            let face = cross(sub(c[1], c[0]), sub(c[2], c[0]));
-            (t.iter().all(|&x| dot(face, self.nrm[x as usize]) > 0.0)
-                && self.covers_none(ring, t)
-                && self.face_meets_nothing(t))
-            .then(|| angles(c).into_iter().fold(f64::INFINITY, f64::min))
+            (self.covers_none(ring, t) && self.fits_across_bend(t)).then(|| {
+                angles(corners(&self.pos, t))
+                    .into_iter()
+                    .fold(f64::INFINITY, f64::min)
+            })
         };
         // best[i][k]: the best smallest angle of the sub-polygon i..=k, and its apex on i–k.
         let mut best = vec![vec![None::<(f64, usize)>; m]; m];
@@ -1931,7 +1936,6 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
         });
         self.push_vertex(q, normal, s + length, theta, point);
         let n = ring.len();
-        let fan = |i: usize| [ring[(i + 1) % n], ring[i], x];
         let fits = (0..n).all(|i| {
             let (a, b) = (ring[i], ring[(i + 1) % n]);
             self.score(a, b, x, f64::INFINITY, 0.0).is_some() && self.meets_nothing(a, b, x)
@@ -1942,7 +1946,7 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
         }
         self.register(x, ring[0], ring[1]);
         for i in 0..n {
-            self.add(fan(i));
+            self.add([ring[(i + 1) % n], ring[i], x]);
         }
         true
     }
@@ -2329,8 +2333,8 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
     }
 
     /// The point of the surface over chart point `target` (on the chart's plane, normal `n`),
-    /// reached by chords from the nearest of the vertices `starts` (in the working precision, in hops of
-    /// at most `hop_length`), with its unit field normal, if that normal is within
+    /// reached by chords from the nearest of the vertices `starts` (in the working precision,
+    /// in hops of at most `hop_length`), with its unit field normal, if that normal is within
     /// `turn_cos` of `n`.
     ///
     /// Distances are measured across the plane: the surface lies above or below it, by
