@@ -160,6 +160,17 @@ fn check_with<F: NormalField<f64>>(
         {
             prop_assert!(holes > 0, "{context}: open, yet no hole reported")
         }
+        // More boundary loops than a whole band or disc has: the extra ones are holes, and
+        // the run must say so.
+        Shape::Band | Shape::Disc
+            if loops > if matches!(shape, Shape::Band) { 2 } else { 1 }
+                && run.cut_short().is_empty() =>
+        {
+            prop_assert!(
+                holes > 0,
+                "{context}: an extra boundary loop, yet no hole reported"
+            )
+        }
         _ => {}
     }
     if !fits {

@@ -977,3 +977,37 @@ fn a_bands_end_at_the_bounding_box_is_no_hole() {
     assert!(v.euler_characteristic == 0 && v.boundary_loops == 2, "{v}");
     assert_eq!(run.stitched.holes, 0, "{:?}", run.stitched);
 }
+
+/// Found by `tests/classes.rs` at `PROPTEST_RNG_SEED=777001` (256 cases): a thin elliptic
+/// cylinder (semi-axes 0.0095 and 0.030, along a turned axis) came out with a third boundary
+/// loop, a hole of four edges about 100 mesh edges long beside one end, and the run said it
+/// had no hole: one corner lay within its longest boundary edge of the bounding box. It is 1.5
+/// longest steps (`dt_max`) from it, farther than any curve's end at the box can be.
+#[test]
+fn a_hole_beside_a_thin_cylinders_end_is_reported() {
+    let numbers = [
+        0.0,
+        11096.084760816297,
+        1119.3635265200573,
+        1.3511548624872503,
+        0.6046932923615126,
+        -0.6500317965557296,
+    ];
+    let invariant = Invariant::from_numbers(&numbers)
+        .unwrap()
+        .with_reading(liemesh::model::AngleReading::Quadric);
+    let p0 = [
+        -0.015024380222104472,
+        0.004053271058145614,
+        0.007117136376096534,
+    ];
+    let run = liemesh::run(&LieField::<f64>::new(&invariant), &MeshParams::at(p0)).unwrap();
+    let v = &run.validation;
+    assert!(v.is_valid() && v.components == 1, "{v}");
+    // A band has two loops; every one beyond them is a hole the run must count.
+    assert!(
+        run.stitched.holes + 2 >= v.boundary_loops,
+        "{v}; {:?}",
+        run.stitched
+    );
+}

@@ -186,9 +186,11 @@ fn rim_of<T>(samples: &Samples<T>, pr: &Provenance) -> stitch::Rim {
 ///
 /// A vertex is on the rim where a curve ended on a terminal condition, at a singular point or
 /// on a budget, and also where it lies within its longest boundary edge of the bounding box or
-/// of the geodesic radius (`params`): the end of a curve that reached them may have gone with
-/// the triangles the validation dropped, leaving a band's end (a cylinder's, at the box) lined
-/// with vertices of curves that merged there.
+/// of the geodesic radius (`params`), and within the longest step `dt_max`: the end of a curve
+/// that reached them may have gone with the triangles the validation dropped, leaving a
+/// band's end (a cylinder's, at the box) lined with vertices of curves that merged there. (A
+/// hole of a few long edges beside the box is not on the rim: a thin cylinder's, four edges
+/// of 100 mesh edges each, one corner 1.5 longest steps from the box.)
 pub(crate) fn holes<T>(
     samples: &Samples<T>,
     params: &Resolved,
@@ -207,7 +209,8 @@ pub(crate) fn holes<T>(
     for &(a, b) in boundary {
         loops.union(index(a), index(b));
     }
-    // Each boundary vertex's longest boundary edge.
+    // Each boundary vertex's longest boundary edge, but at most the longest step: a curve
+    // that reached the box or the radius ended within a step of it.
     let mut reach = vec![0.0f64; ends.len()];
     for &(a, b) in boundary {
         let length = match (mesh.vertices.get(a as usize), mesh.vertices.get(b as usize)) {
@@ -218,6 +221,9 @@ pub(crate) fn holes<T>(
             let k = index(v) as usize;
             reach[k] = reach[k].max(length);
         }
+    }
+    for r in &mut reach {
+        *r = r.min(params.dt_max);
     }
     // A loop is on the rim if any of its vertices is.
     let mut on_rim = vec![false; ends.len()];
