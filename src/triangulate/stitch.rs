@@ -157,12 +157,12 @@ pub(crate) const MAX_TILT_DEG: f64 = 60.0;
 /// [`MAX_TILT_DEG`] for the front's triangles on a field integrable at `p0`, degrees. A
 /// triangle across a bend tilts from its corners' normals by about half the bend: at 60°,
 /// the front glued corners a fifth of a thin tube's girth apart where fronts met along a
-/// seam (a cylinder's face 48° off the surface, a torus's 86°), and a hole's chart patch,
-/// short of points, spanned a thick cylinder's seam with faces 30 mesh edges long and 63°
-/// off. Ellipsoids, whose fronts meet round a cap, triangles on the end of a curve stopped
-/// at a singular point and the last small holes keep the wider limit: a far tip can bend
-/// more sharply than the triangles there (`[1, 20, 400]` from `(1, 0, 0)`), and a cone's
-/// apex turns the normals faster than any triangle can follow.
+/// seam (a cylinder's face 48° off the surface, a torus's 86°). Ellipsoids, whose fronts
+/// meet round a cap, triangles on the end of a curve stopped at a singular point, chart
+/// patches and the last small holes keep the wider limit: a far tip can bend more sharply
+/// than the triangles there (`[1, 20, 400]` from `(1, 0, 0)`), a cone's apex turns the
+/// normals faster than any triangle can follow, and patches held to 30° left a tanglecube's
+/// neck open.
 const FRONT_TILT_DEG: f64 = 30.0;
 
 /// What stitching where fronts met did.
@@ -2413,7 +2413,7 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
             .then_some((q, normal, point))
     }
 
-    /// The largest tilt of a stitched triangle on corners `t` from their field normals,
+    /// The largest tilt of a front triangle on corners `t` from their field normals,
     /// degrees: [`FRONT_TILT_DEG`] on a seam of an integrable surface other than an
     /// ellipsoid, away from curves stopped at a singular point; [`MAX_TILT_DEG`] elsewhere.
     fn tilt_limit(&self, t: [u32; 3]) -> f64 {
@@ -2427,7 +2427,7 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
 
     /// Whether a triangle `t` of a hole's chart patch may go in: counter-clockwise in the
     /// chart (frame `e1`, `e2` at `centre`) also after lifting, facing the field at each
-    /// corner within [`Self::tilt_limit`], and meeting no triangle already there (exact).
+    /// corner within [`MAX_TILT_DEG`], and meeting no triangle already there (exact).
     fn patch_triangle_fits(
         &self,
         t: [u32; 3],
@@ -2445,7 +2445,7 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
             - (p2[1][1] - p2[0][1]) * (p2[2][0] - p2[0][0]);
         let face = cross(sub(c[1], c[0]), sub(c[2], c[0]));
         let ff = dot(face, face);
-        let cos_tilt = self.tilt_limit(t).to_radians().cos();
+        let cos_tilt = MAX_TILT_DEG.to_radians().cos();
         if !(turn > 0.0 && ff > 0.0 && dot(face, n) > 0.0) {
             return false;
         }
