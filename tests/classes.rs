@@ -92,6 +92,17 @@ enum Shape {
     Swept(usize),
 }
 
+impl Shape {
+    /// How many boundary loops the whole surface has (a band two, a disc one; else none).
+    fn own_loops(self) -> usize {
+        match self {
+            Shape::Band => 2,
+            Shape::Disc => 1,
+            _ => 0,
+        }
+    }
+}
+
 /// Meshes `field` from `p0` with default parameters and checks validity and `shape`.
 fn check<F: NormalField<f64>>(
     field: &F,
@@ -179,10 +190,7 @@ fn check_with<F: NormalField<f64>>(
         }
         // More boundary loops than a whole band or disc has: the extra ones are holes, and
         // the run must say so.
-        Shape::Band | Shape::Disc
-            if loops > if matches!(shape, Shape::Band) { 2 } else { 1 }
-                && run.cut_short().is_empty() =>
-        {
+        Shape::Band | Shape::Disc if loops > shape.own_loops() && run.cut_short().is_empty() => {
             prop_assert!(
                 holes > 0,
                 "{context}: an extra boundary loop, yet no hole reported"

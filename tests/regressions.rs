@@ -968,14 +968,22 @@ fn a_bands_end_at_the_bounding_box_is_no_hole() {
         -1.3509066063804709,
         -2.467483042013092,
     ];
+    let p0 = [2.3375931613882996, -0.9396169197918688, 0.8179670760277526];
+    let (_, run) = posed_band(numbers, p0);
+    assert_eq!(run.stitched.holes, 0, "{:?}", run.stitched);
+}
+
+/// The quadric of `numbers` read as a posed quadric's, meshed with defaults from `p0` and
+/// checked to be a band (χ = 0, two boundary loops); its field and the run.
+fn posed_band(numbers: [f64; 6], p0: [f64; 3]) -> (LieField<f64>, liemesh::MeshRun<f64>) {
     let invariant = Invariant::from_numbers(&numbers)
         .unwrap()
         .with_reading(liemesh::model::AngleReading::Quadric);
-    let p0 = [2.3375931613882996, -0.9396169197918688, 0.8179670760277526];
-    let run = liemesh::run(&LieField::<f64>::new(&invariant), &MeshParams::at(p0)).unwrap();
+    let field = LieField::<f64>::new(&invariant);
+    let run = liemesh::run(&field, &MeshParams::at(p0)).unwrap();
     let v = &run.validation;
     assert!(v.euler_characteristic == 0 && v.boundary_loops == 2, "{v}");
-    assert_eq!(run.stitched.holes, 0, "{:?}", run.stitched);
+    (field, run)
 }
 
 /// Found by `tests/classes.rs` at `PROPTEST_RNG_SEED=777001` (256 cases): a thin elliptic
@@ -995,18 +1003,12 @@ fn a_thin_elliptic_cylinder_is_a_whole_band() {
         0.6046932923615126,
         -0.6500317965557296,
     ];
-    let invariant = Invariant::from_numbers(&numbers)
-        .unwrap()
-        .with_reading(liemesh::model::AngleReading::Quadric);
-    let field = LieField::<f64>::new(&invariant);
     let p0 = [
         -0.015024380222104472,
         0.004053271058145614,
         0.007117136376096534,
     ];
-    let run = liemesh::run(&field, &MeshParams::at(p0)).unwrap();
-    let v = &run.validation;
-    assert!(v.euler_characteristic == 0 && v.boundary_loops == 2, "{v}");
+    let (_, run) = posed_band(numbers, p0);
     assert_eq!(run.stitched.holes, 0, "{:?}", run.stitched);
 }
 
@@ -1026,18 +1028,12 @@ fn a_cylinders_seam_follows_the_surface() {
         -0.7312411820130273,
         2.3297804317184263,
     ];
-    let invariant = Invariant::from_numbers(&numbers)
-        .unwrap()
-        .with_reading(liemesh::model::AngleReading::Quadric);
-    let field = LieField::<f64>::new(&invariant);
     let p0 = [
         -0.9258083303879117,
         -0.06850174576598472,
         -0.3057316888557692,
     ];
-    let run = liemesh::run(&field, &MeshParams::at(p0)).unwrap();
-    let v = &run.validation;
-    assert!(v.euler_characteristic == 0 && v.boundary_loops == 2, "{v}");
+    let (field, run) = posed_band(numbers, p0);
     let (worst, _) = liemesh::quality::face_normal_error(&field, &run.mesh);
     assert!(worst < 30.0, "a face {worst:.1}° off the surface");
 }

@@ -219,11 +219,8 @@ pub(crate) fn holes<T>(
         };
         for v in [a, b] {
             let k = index(v) as usize;
-            reach[k] = reach[k].max(length);
+            reach[k] = reach[k].max(length.min(params.dt_max));
         }
-    }
-    for r in &mut reach {
-        *r = r.min(params.dt_max);
     }
     // A loop is on the rim if any of its vertices is.
     let mut on_rim = vec![false; ends.len()];

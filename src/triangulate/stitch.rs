@@ -11,7 +11,9 @@
 //!
 //! - it lies in the open wedge of all three of its corners (it covers nothing already covered),
 //! - it faces the way the field does (its normal within [`FRONT_TILT_DEG`] of the corners'
-//!   field normals on an integrable field, [`MAX_TILT_DEG`] on a swept one) and is not a sliver (smallest angle at least [`MIN_ANGLE_DEG`]),
+//!   field normals on a seam of an integrable surface other than an ellipsoid,
+//!   [`MAX_TILT_DEG`] elsewhere) and is not a sliver (smallest angle at least
+//!   [`MIN_ANGLE_DEG`]),
 //! - its new edges are no longer than [`REACH`] local edge lengths,
 //! - it keeps every edge on at most two triangles, and
 //! - it meets no existing triangle other than along the edges and corners it shares with them
@@ -183,11 +185,10 @@ pub struct Stitched {
     pub budget_hit: bool,
     /// Boundary loops of the returned mesh with no vertex where a curve ended on a terminal
     /// condition, at a singular point or on a budget, nor within its longest boundary edge
-    /// and the longest step of the bounding box or the geodesic radius (loops touching at a
-    /// vertex count as one):
-    /// holes where the surface goes on and the mesh does not. On a surface integrable at
-    /// `p0`, fronts that met and were not stitched; on a swept surface, also where it was cut
-    /// back (its folds, or the sheet about to cross itself).
+    /// (and the longest step) of the bounding box or the geodesic radius (loops touching at
+    /// a vertex count as one): holes where the surface goes on and the mesh does not. On a
+    /// surface integrable at `p0`, fronts that met and were not stitched; on a swept
+    /// surface, also where it was cut back (its folds, or the sheet about to cross itself).
     #[cfg_attr(feature = "serde", serde(default))]
     pub holes: usize,
 }
