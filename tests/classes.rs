@@ -54,11 +54,17 @@ const TILTED_TORUS_MISSES: u32 = 5;
 
 /// The largest angle between a face and the field normal at its centroid allowed on
 /// ellipsoids and tori, degrees (the default β band turns the normal 4°–8° a step). Measured
-/// at 26.7° at most over 256 cases of each (`PROPTEST_CASES=256`, this file's seeds and
+/// at 24.7° at most over 256 cases of each (`PROPTEST_CASES=256`, this file's seeds and
 /// `PROPTEST_RNG_SEED=777001`); tori reached 86° before the stitching's front was held to
-/// 30° of tilt on seams. Bands are not held to it yet: a hole's last triangles may still
-/// tilt to 63° (docs/status.md), and cones and cubics meet singular points.
+/// 30° of tilt on seams. Cones and cubics are not held to a bound: their faces at a singular
+/// point (a cone's apex) span normals far apart.
 const MAX_FACE_NORMAL_ERROR_DEG: f64 = 45.0;
+
+/// The same bound on bands and discs (cylinders, hyperboloids). Measured over the same
+/// cases at 47.6° at most on cylinders (a hole's last sliver ears, which may tilt: one
+/// cylinder at this file's seed), 31.1° on one-sheet and 23.0° on two-sheet hyperboloids;
+/// a thin cylinder reached 85.9° before the flips were held to 30° of tilt.
+const MAX_FACE_NORMAL_ERROR_OPEN_DEG: f64 = 60.0;
 
 fn runner(seed: u64) -> TestRunner {
     let mut config = Config {
@@ -156,12 +162,17 @@ fn check_with<F: NormalField<f64>>(
             run.cut_short()
         );
     }
-    // Surface fidelity (DESIGN §4): on the closed integrable classes every face lies within
-    // `MAX_FACE_NORMAL_ERROR_DEG` of the field normal at its centroid.
-    if matches!(shape, Shape::Closed(_)) {
+    // Surface fidelity (DESIGN §4): on the integrable classes without a singular point every
+    // face lies within a bound of the field normal at its centroid.
+    let bound = match shape {
+        Shape::Closed(_) => Some(MAX_FACE_NORMAL_ERROR_DEG),
+        Shape::Band | Shape::Disc => Some(MAX_FACE_NORMAL_ERROR_OPEN_DEG),
+        Shape::Nappe | Shape::Swept(_) => None,
+    };
+    if let Some(bound) = bound {
         let (worst, _) = liemesh::quality::face_normal_error(field, mesh);
         prop_assert!(
-            worst <= MAX_FACE_NORMAL_ERROR_DEG,
+            worst <= bound,
             "{context}: a face {worst:.1}° off the surface"
         );
     }

@@ -5,12 +5,18 @@
 //! flips with the surface criterion — flip an edge when the two angles opposite to it add up
 //! to more than π — restore the max-min-angle property on the surface. A flip is taken only
 //! when it keeps the mesh a consistently oriented 2-manifold whose faces agree with the field
-//! normal; flips that undo a fold (a face against the field normal) come first.
+//! normal, and tilts no face further than [`FLIP_TILT_DEG`] from it unless the pair it
+//! replaces tilted further; flips that undo a fold (a face against the field normal) come
+//! first.
 
 use crate::geom::rows::rows_by_corner;
 use crate::geom::vec3::{cross, dot, sub, FastHash};
 use crate::par;
 use std::collections::{HashMap, VecDeque};
+
+/// The furthest a flip may tilt a triangle from its corners' field normals (their sum),
+/// degrees, unless the pair it replaces tilted further.
+const FLIP_TILT_DEG: f64 = 30.0;
 
 /// Angle at `c` in triangle (a, b, c).
 fn angle_at(c: [f64; 3], a: [f64; 3], b: [f64; 3]) -> f64 {
@@ -323,8 +329,9 @@ impl HalfEdges {
 
     /// Whether the edge `ab` between the triangles `(a, b, c)` and `(b, a, d)` should be
     /// flipped to `cd`: it is not Delaunay on the surface or one of its triangles faces against
-    /// the field (`was_folded`), the edge `cd` is new, both new triangles agree with the field,
-    /// and they do not fold over the old pair unless that undoes a fold.
+    /// the field (`was_folded`), the edge `cd` is new, both new triangles agree with the field
+    /// (within [`FLIP_TILT_DEG`], or at least as well as the old pair), and they do not fold
+    /// over the old pair unless that undoes a fold.
     #[inline(always)]
     fn wants_flip(
         &self,
@@ -353,6 +360,16 @@ impl HalfEdges {
         }
         let new_ok = !against_field(points, normals, new1) && !against_field(points, normals, new2);
         if !new_ok {
+            return false;
+        }
+        // Nor may it tilt a triangle further from the field than [`FLIP_TILT_DEG`], unless the
+        // old pair tilted further still: on a thin tube the wider of a long quad's diagonals
+        // can be the Delaunay one and still cut across the surface.
+        let cos_tilt = |t: [u32; 3]| agreement(points, normals, t);
+        let new_cos = cos_tilt(new1).min(cos_tilt(new2));
+        if new_cos < FLIP_TILT_DEG.to_radians().cos()
+            && new_cos < cos_tilt(old1).min(cos_tilt(old2))
+        {
             return false;
         }
         // The flipped pair must not fold over the old one (the quad must be convex enough)
@@ -853,6 +870,32 @@ mod tests {
         assert!(edges.contains(&(1, 3)) || edges.contains(&(3, 1)));
         // Now Delaunay: a second pass changes nothing.
         assert_eq!(flip_to_surface_delaunay(&p, &n, &mut t, 10, &[]).flips, 0);
+    }
+
+    #[test]
+    fn a_flip_across_a_tube_that_would_tilt_its_faces_is_not_taken() {
+        // 0–2 runs along the top of a narrow tube, 1 and 3 lie down its sides, whose normals
+        // point sideways. 0–2 is not Delaunay (its opposite angles are 96° each), but the
+        // diagonal 1–3 cuts across the tube: its faces would tilt 36.9° from their corners'
+        // normals, against 29.7° now.
+        let p = vec![
+            [-2.0, 0.0, 0.0],
+            [0.0, -1.0, -1.5],
+            [2.0, 0.0, 0.0],
+            [0.0, 1.0, -1.5],
+        ];
+        let n = vec![
+            [0.0, 0.0, 1.0],
+            [0.0, -1.0, 0.0],
+            [0.0, 0.0, 1.0],
+            [0.0, 1.0, 0.0],
+        ];
+        let mut t = vec![[0, 1, 2], [0, 2, 3]];
+        let tilt = |t: [u32; 3]| agreement(&p, &n, t).acos().to_degrees();
+        assert!((tilt([0, 1, 2]) - 29.7).abs() < 0.1 && (tilt([0, 1, 3]) - 36.9).abs() < 0.1);
+        let pass = flip_to_surface_delaunay(&p, &n, &mut t, 10, &[]);
+        assert_eq!(pass.flips, 0);
+        assert_eq!(t, vec![[0, 1, 2], [0, 2, 3]]);
     }
 
     #[test]
