@@ -93,6 +93,18 @@ pub(crate) fn against_field(p: &[[f64; 3]], n: &[[f64; 3]], t: [u32; 3]) -> bool
     cosine(f, g) <= 0.0
 }
 
+/// `agreement(p, n, t) >= cos_limit` for a positive `cos_limit`, without a square root or a
+/// division where the products are normal numbers (the flips ask it of every flip they
+/// consider).
+fn within_tilt(p: &[[f64; 3]], n: &[[f64; 3]], t: [u32; 3], cos_limit: f64) -> bool {
+    let (f, g) = (face_normal(p, t), field_normal(n, t));
+    let (fg, dd) = (dot(f, g), dot(f, f) * dot(g, g));
+    if fg > 1e-140 && fg < 1e140 && (1e-280..=1e280).contains(&dd) {
+        return fg * fg >= cos_limit * cos_limit * dd;
+    }
+    agreement(p, n, t) >= cos_limit
+}
+
 /// No half-edge.
 const NONE: u32 = u32::MAX;
 
@@ -365,12 +377,13 @@ impl HalfEdges {
         // Nor may it tilt a triangle further from the field than [`FLIP_TILT_DEG`], unless the
         // old pair tilted further still: on a thin tube the wider of a long quad's diagonals
         // can be the Delaunay one and still cut across the surface.
-        let cos_tilt = |t: [u32; 3]| agreement(points, normals, t);
-        let new_cos = cos_tilt(new1).min(cos_tilt(new2));
-        if new_cos < FLIP_TILT_DEG.to_radians().cos()
-            && new_cos < cos_tilt(old1).min(cos_tilt(old2))
+        let limit = FLIP_TILT_DEG.to_radians().cos();
+        if !(within_tilt(points, normals, new1, limit) && within_tilt(points, normals, new2, limit))
         {
-            return false;
+            let cos_tilt = |t: [u32; 3]| agreement(points, normals, t);
+            if cos_tilt(new1).min(cos_tilt(new2)) < cos_tilt(old1).min(cos_tilt(old2)) {
+                return false;
+            }
         }
         // The flipped pair must not fold over the old one (the quad must be convex enough)
         // unless it undoes a fold.
@@ -842,6 +855,42 @@ mod tests {
         }
         // Both answers occur often (extreme scales make many faces degenerate).
         assert!((5_000..25_000).contains(&against), "{against}");
+    }
+
+    #[test]
+    fn within_tilt_is_the_agreement_against_the_limit() {
+        let mut rng = crate::geom::rng::XorShift64::new(29);
+        let limit = FLIP_TILT_DEG.to_radians().cos();
+        let mut within = 0;
+        for k in 0..30_000 {
+            let range = if k % 2 == 0 { 3.0 } else { 200.0 };
+            let scale = 10f64.powf(rng.uniform(-range, range));
+            let p: Vec<[f64; 3]> = (0..3).map(|_| rng.in_cube(scale)).collect();
+            // Normals near the face's for a third of the faces, so that both answers occur.
+            let f = face_normal(&p, [0, 1, 2]);
+            let n: Vec<[f64; 3]> = (0..3)
+                .map(|_| {
+                    let r = rng.in_cube(1.0);
+                    let u = if k % 3 == 0 {
+                        [f[0] + r[0] * dot(f, f).sqrt(), f[1], f[2]]
+                    } else {
+                        r
+                    };
+                    u.map(|x| x * 10f64.powf(rng.uniform(-range, range)))
+                })
+                .collect();
+            let cos = agreement(&p, &n, [0, 1, 2]);
+            if (cos - limit).abs() < 1e-12 {
+                continue;
+            }
+            within += usize::from(cos >= limit);
+            assert_eq!(
+                within_tilt(&p, &n, [0, 1, 2], limit),
+                cos >= limit,
+                "{p:?} {n:?}"
+            );
+        }
+        assert!((1_000..29_000).contains(&within), "{within}");
     }
 
     /// A flat rhombus in the plane z = 0 whose diagonal 0–2 is the long one.
