@@ -171,23 +171,22 @@ fn check_with<F: NormalField<f64>>(
     // Surface fidelity (DESIGN §4): on the integrable classes every face lies within a bound
     // of the field normal at its centroid; on a cone, every face clear of the apex (the
     // origin: the class's cones are centred), about which faces span normals far apart.
-    let worst = match shape {
-        Shape::Closed(_) | Shape::Band | Shape::Disc => {
-            Some(liemesh::quality::face_normal_error(field, mesh).0)
-        }
-        Shape::Nappe => Some(face_normal_error_away_from(
-            field,
-            mesh,
-            [0.0; 3],
-            APEX_CLEARANCE,
+    let fidelity = match shape {
+        Shape::Closed(_) => Some((
+            liemesh::quality::face_normal_error(field, mesh).0,
+            MAX_FACE_NORMAL_ERROR_DEG,
+        )),
+        Shape::Band | Shape::Disc => Some((
+            liemesh::quality::face_normal_error(field, mesh).0,
+            MAX_FACE_NORMAL_ERROR_OPEN_DEG,
+        )),
+        Shape::Nappe => Some((
+            face_normal_error_away_from(field, mesh, [0.0; 3], APEX_CLEARANCE),
+            MAX_FACE_NORMAL_ERROR_OPEN_DEG,
         )),
         Shape::Swept(_) => None,
     };
-    let bound = match shape {
-        Shape::Closed(_) => MAX_FACE_NORMAL_ERROR_DEG,
-        _ => MAX_FACE_NORMAL_ERROR_OPEN_DEG,
-    };
-    if let Some(worst) = worst {
+    if let Some((worst, bound)) = fidelity {
         prop_assert!(
             worst <= bound,
             "{context}: a face {worst:.1}° off the surface"
@@ -568,30 +567,18 @@ fn face_normal_error_away_from<F: NormalField<f64>>(
     point: [f64; 3],
     clearance: f64,
 ) -> f64 {
-    let sub = |a: [f64; 3], b: [f64; 3]| [a[0] - b[0], a[1] - b[1], a[2] - b[2]];
-    let dot = |a: [f64; 3], b: [f64; 3]| a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+    let dist = |a: [f64; 3], b: [f64; 3]| {
+        ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2) + (a[2] - b[2]).powi(2)).sqrt()
+    };
     let mut worst = 0.0_f64;
     for t in &mesh.triangles {
         let c = t.map(|i| mesh.vertices[i as usize]);
         let longest = (0..3)
-            .map(|k| dot(sub(c[k], c[(k + 1) % 3]), sub(c[k], c[(k + 1) % 3])).sqrt())
+            .map(|k| dist(c[k], c[(k + 1) % 3]))
             .fold(0.0, f64::max);
-        if c.iter()
-            .any(|&v| dot(sub(v, point), sub(v, point)).sqrt() <= clearance * longest)
-        {
-            continue;
+        if c.iter().all(|&v| dist(v, point) > clearance * longest) {
+            worst = worst.max(liemesh::quality::face_error_deg(c, |x| field.normal(x)));
         }
-        let (u, v) = (sub(c[1], c[0]), sub(c[2], c[0]));
-        let face = [
-            u[1] * v[2] - u[2] * v[1],
-            u[2] * v[0] - u[0] * v[2],
-            u[0] * v[1] - u[1] * v[0],
-        ];
-        let centroid = [0, 1, 2].map(|k| (c[0][k] + c[1][k] + c[2][k]) / 3.0);
-        let n = field.normal(&Vec3::from_f64(centroid));
-        let g = [n.x, n.y, n.z];
-        let cos = dot(face, g) / (dot(face, face) * dot(g, g)).sqrt();
-        worst = worst.max(cos.clamp(-1.0, 1.0).acos().to_degrees());
     }
     worst
 }

@@ -957,7 +957,8 @@ fn assert_far_cap_charted(growth: f64, new_points: usize, min_angle: f64) {
 /// a band (χ = 0, two loops, both at the bounding box) but one end was reported as a hole.
 /// Its vertices belonged to curves that merged beside the box: the ends of the curves that
 /// reached the box had gone with triangles the validation dropped. A boundary vertex within
-/// its longest boundary edge of the box (or of the geodesic radius) is on the rim too.
+/// its longest boundary edge of the box (or of the geodesic radius) is on the rim too. Its
+/// faces keep within 30° of the surface as well.
 #[test]
 fn a_bands_end_at_the_bounding_box_is_no_hole() {
     let numbers = [
@@ -1012,8 +1013,10 @@ fn a_thin_elliptic_cylinder_is_a_whole_band() {
         0.004053271058145614,
         0.007117136376096534,
     ];
-    let (_, run) = posed_band(numbers, p0);
+    let (field, run) = posed_band(numbers, p0);
     assert_eq!(run.stitched.holes, 0, "{:?}", run.stitched);
+    let (worst, _) = liemesh::quality::face_normal_error(&field, &run.mesh);
+    assert!(worst < 30.0, "a face {worst:.1}° off the surface");
 }
 
 /// Found by `tests/classes.rs` at `PROPTEST_RNG_SEED=777001`: a 0.89 × 0.52 elliptic

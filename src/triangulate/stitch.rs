@@ -184,10 +184,10 @@ pub struct Stitched {
     /// last step then filled leaves none: the mesh is as stitched as without the budget.)
     pub budget_hit: bool,
     /// Boundary loops of the returned mesh with no vertex where a curve ended on a terminal
-    /// condition, at a singular point or on a budget, nor within its longest boundary edge
-    /// (and the longest step) of the bounding box or the geodesic radius (loops touching at
-    /// a vertex count as one): holes where the surface goes on and the mesh does not. On a
-    /// surface integrable at `p0`, fronts that met and were not stitched; on a swept
+    /// condition, at a singular point or on a budget, nor within the shorter of its longest
+    /// boundary edge and the longest step of the bounding box or the geodesic radius (loops
+    /// touching at a vertex count as one): holes where the surface goes on and the mesh does
+    /// not. On a surface integrable at `p0`, fronts that met and were not stitched; on a swept
     /// surface, also where it was cut back (its folds, or the sheet about to cross itself).
     #[cfg_attr(feature = "serde", serde(default))]
     pub holes: usize,
