@@ -62,7 +62,8 @@ const MAX_FACE_NORMAL_ERROR_DEG: f64 = 45.0;
 
 /// That bound on bands, discs and cones (cylinders, hyperboloids; on cones the faces
 /// clear of the apex by [`APEX_CLEARANCE`]). Measured over the same cases at 47.6° at most on
-/// cylinders (a hole's last sliver ears, which may tilt: one cylinder at this file's seed),
+/// cylinders (one cylinder at this file's seed: a well-shaped face of the last round's
+/// ear clipping, across the sharp ends of a 15:5 ellipse where samples are sparse),
 /// 31.1° on one-sheet and 23.0° on two-sheet hyperboloids, 46.1° on cones; a thin cylinder
 /// reached 85.9° before the flips were held to 30° of tilt.
 const MAX_FACE_NORMAL_ERROR_OPEN_DEG: f64 = 60.0;
