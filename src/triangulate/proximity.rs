@@ -64,6 +64,9 @@ fn coarse(c: Cell, level: u32) -> Cell {
     (c.0 >> s, c.1 >> s, c.2 >> s)
 }
 
+/// A level's rows by coarse cell, each with its own cell (see [`Level::coarse`]).
+type CoarseIndex = HashMap<Cell, Vec<(Cell, u32)>, FastHash>;
+
 /// The triangles filed at one level.
 ///
 /// The triangles given at construction are filed once, in compressed rows by cell (no list
@@ -83,7 +86,7 @@ struct Level {
     /// the triangles near its box rather than the whole level. On `[1, 1, 150]` meshed from
     /// its rim, 124 whole-level scans were 52.6M of the stitching's 55M visits and ran its
     /// budget out.
-    coarse: [OnceCell<HashMap<Cell, Vec<(Cell, u32)>, FastHash>>; COARSE_INDEXES],
+    coarse: [OnceCell<CoarseIndex>; COARSE_INDEXES],
 }
 
 impl Default for Level {
@@ -117,7 +120,7 @@ impl Level {
             };
             let (clo, chi) = (coarse_cell(lo, depth), coarse_cell(hi, depth));
             let coarse = self.coarse[depth as usize - 1].get_or_init(|| {
-                let mut coarse: HashMap<Cell, Vec<(Cell, u32)>, FastHash> = HashMap::default();
+                let mut coarse = CoarseIndex::default();
                 for (&cell, &r) in &self.rows {
                     coarse
                         .entry(coarse_cell(cell, depth))
