@@ -52,16 +52,19 @@ const LEVEL_BITS: u32 = 2;
 /// Levels above the base one: cells up to `4^16 ≈ 4·10⁹` base cells wide.
 const MAX_LEVEL: u32 = 16;
 
+/// The cell `2^bits` times as wide that holds cell `c` (floor division on each axis).
+fn shifted(c: Cell, bits: u32) -> Cell {
+    (c.0 >> bits, c.1 >> bits, c.2 >> bits)
+}
+
 /// The cell of a level's `depth`-th coarse index that holds the level's cell `c`.
 fn coarse_cell(c: Cell, depth: u32) -> Cell {
-    let s = COARSE_BITS * depth;
-    (c.0 >> s, c.1 >> s, c.2 >> s)
+    shifted(c, COARSE_BITS * depth)
 }
 
 /// The cell at `level` that holds base-level cell `c` (floor division by `4^level`).
 fn coarse(c: Cell, level: u32) -> Cell {
-    let s = LEVEL_BITS * level;
-    (c.0 >> s, c.1 >> s, c.2 >> s)
+    shifted(c, LEVEL_BITS * level)
 }
 
 /// A level's rows by coarse cell, each with its own cell (see [`Level::coarse`]).
