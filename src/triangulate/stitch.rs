@@ -1738,13 +1738,18 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
             .map(|k| dist(centre, corners_t[k]))
             .fold(0.0, f64::max)
             + clearance;
+        // Points outside the triangle's box grown by the clearance are farther than that
+        // from it: most of the ball's points on a coarse front, rejected before the distance.
+        let (lo, hi) = bounds(&corners_t);
+        let (lo, hi) = (lo.map(|x| x - clearance), hi.map(|x| x + clearance));
         let mut crowded = false;
         let mut visits = 0;
         self.points.near(centre, radius, |w| {
             visits += 1;
             let p = self.pos[w as usize];
             crowded = crowded
-                || (!t.contains(&w)
+                || ((0..3).all(|k| lo[k] <= p[k] && p[k] <= hi[k])
+                    && !t.contains(&w)
                     && (self.on_boundary(w)
                         // A free vertex right next to a corner is a near-duplicate of it and
                         // stays unused; one farther in would be left under the triangle.
