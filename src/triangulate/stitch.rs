@@ -1527,10 +1527,9 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
         // Against each corner's normal, not only their sum: corners on opposite sides of a
         // thin tube sum to almost nothing, and a triangle across the tube must not pass.
         let cos_tilt = self.tilt_limit([a, b, x]).to_radians().cos();
-        let tilted = [self.nrm[a as usize], self.nrm[b as usize], nx]
+        let leans = [field, self.nrm[a as usize], self.nrm[b as usize], nx]
             .iter()
-            .any(|n| dot(face, *n) < cos_tilt * (ff * dot(*n, *n)).sqrt());
-        let leans = dot(face, field) < cos_tilt * (ff * gg).sqrt() || tilted;
+            .any(|&n| tilts_past(face, ff, n, cos_tilt));
         // With a floor on the angles no triangle is a sliver (below): the facing test comes
         // before the angles, which are dearer.
         if !(ff > 0.0 && gg > 0.0) || (min_floor != 0.0 && leans) {
@@ -2451,14 +2450,13 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
             - (p2[1][1] - p2[0][1]) * (p2[2][0] - p2[0][0]);
         let face = cross(sub(c[1], c[0]), sub(c[2], c[0]));
         let ff = dot(face, face);
-        let cos_tilt = MAX_TILT_DEG.to_radians().cos();
         if !(turn > 0.0 && ff > 0.0 && dot(face, n) > 0.0) {
             return false;
         }
-        if t.iter().any(|&v| {
-            dot(face, self.nrm[v as usize])
-                < cos_tilt * (ff * dot(self.nrm[v as usize], self.nrm[v as usize])).sqrt()
-        }) {
+        let cos_tilt = MAX_TILT_DEG.to_radians().cos();
+        if t.iter()
+            .any(|&v| tilts_past(face, ff, self.nrm[v as usize], cos_tilt))
+        {
             return false;
         }
         self.face_meets_nothing(t)
@@ -2740,6 +2738,14 @@ fn simple_polygon(p: &[[f64; 2]]) -> bool {
         }
     }
     true
+}
+
+/// Whether a face with normal `face` (of squared length `ff`) is further than the angle whose
+/// cosine is `cos_limit` from the direction `n` (of any length): the front's and the patches'
+/// tilt test, without normalising either.
+#[inline]
+fn tilts_past(face: [f64; 3], ff: f64, n: [f64; 3], cos_limit: f64) -> bool {
+    dot(face, n) < cos_limit * (ff * dot(n, n)).sqrt()
 }
 
 /// The distance from `p` to the triangle `t` (closed).
