@@ -6,10 +6,8 @@
 //! same output invariants are checked; a panic counts as a failure too.
 //! Every failing file is listed with its violation. See `fuzz/README.md`.
 
-// The fuzz targets' checks, the very file the `liemesh-fuzz` crate is built from.
-#[allow(dead_code)]
-#[path = "../fuzz/src/lib.rs"]
-mod fuzz_checks;
+// The fuzz targets' checks (see `tests/suite.rs`).
+use crate::fuzz_checks;
 
 use fuzz_checks::{Target, TARGETS};
 use std::panic::{catch_unwind, AssertUnwindSafe};

@@ -25,10 +25,8 @@
 //!
 //! [`Topology`]: liemesh::quality::Topology
 
-// The fuzz targets' checks, the very file the `liemesh-fuzz` crate is built from.
-#[allow(dead_code)]
-#[path = "../fuzz/src/lib.rs"]
-mod fuzz_checks;
+// The fuzz targets' checks (see `tests/suite.rs`).
+use crate::fuzz_checks;
 
 use fuzz_checks::check_run;
 use liemesh::model::{Invariant, LieField};

@@ -3,10 +3,8 @@
 // Needs invariant files (`examples/ellipsoid.toml`): feature `toml`.
 #![cfg(feature = "toml")]
 
-// The fuzz targets' checks, the very file the `liemesh-fuzz` crate is built from.
-#[allow(dead_code)]
-#[path = "../fuzz/src/lib.rs"]
-mod fuzz_checks;
+// The fuzz targets' checks (see `tests/suite.rs`).
+use crate::fuzz_checks;
 
 use liemesh::io::invariant_file::InvariantFile;
 use liemesh::model::{Invariant, LieField};

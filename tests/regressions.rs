@@ -1,10 +1,8 @@
 //! Regression tests for engine bugs found by the property tests (`tests/properties.rs`) and
 //! the fuzz targets (`fuzz/`). Each is named after the behaviour it pins down.
 
-// The fuzz targets' checks, the very file the `liemesh-fuzz` crate is built from.
-#[allow(dead_code)]
-#[path = "../fuzz/src/lib.rs"]
-mod fuzz_checks;
+// The fuzz targets' checks (see `tests/suite.rs`).
+use crate::fuzz_checks;
 
 use liemesh::model::{Invariant, LieField};
 use liemesh::preset::Preset;

@@ -3,12 +3,10 @@
 //!
 //! The snapshots live in the top-level `snapshots/` folder. After an intended change of the
 //! meshes, review and accept the new ones with `cargo insta review` (or regenerate them with
-//! `INSTA_UPDATE=always cargo test --test snapshots` and inspect the diff).
+//! `INSTA_UPDATE=always cargo test --test suite snapshots::` and inspect the diff).
 
-// The fuzz targets' checks, the very file the `liemesh-fuzz` crate is built from.
-#[allow(dead_code)]
-#[path = "../fuzz/src/lib.rs"]
-mod fuzz_checks;
+// The fuzz targets' checks (see `tests/suite.rs`).
+use crate::fuzz_checks;
 
 use fuzz_checks::{check_chart, check_chart_delaunay};
 use liemesh::model::LieField;

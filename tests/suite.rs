@@ -1,0 +1,55 @@
+//! Every integration test, as one test binary: each file of `tests/` is a module of this one.
+//!
+//! One binary rather than one per file because each test binary compiles the mesher's generic
+//! pipeline again for every scalar and field type it uses (the test profile is optimised, and
+//! optimised builds do not share generic code between crates): with twenty binaries that was
+//! most of a fresh `cargo test --all-features` build (docs/performance.md, "Build time").
+//!
+//! Run one file's tests by its name as a filter, e.g. `cargo test --test suite classes::`.
+
+// The fuzz targets' checks, the very file the `liemesh-fuzz` crate is built from; several of
+// the modules below check outputs with them.
+#[allow(dead_code)]
+#[path = "../fuzz/src/lib.rs"]
+mod fuzz_checks;
+
+#[path = "audit_field.rs"]
+mod audit_field;
+#[path = "audit_jvp.rs"]
+mod audit_jvp;
+#[path = "audit_prediction.rs"]
+mod audit_prediction;
+#[path = "audit_scalars.rs"]
+mod audit_scalars;
+#[path = "classes.rs"]
+mod classes;
+#[path = "cli.rs"]
+mod cli;
+#[path = "cli_batch.rs"]
+mod cli_batch;
+#[path = "cli_bench.rs"]
+mod cli_bench;
+#[path = "derivatives.rs"]
+mod derivatives;
+#[path = "engine.rs"]
+mod engine;
+#[path = "errors.rs"]
+mod errors;
+#[path = "fuzz_corpus.rs"]
+mod fuzz_corpus;
+#[path = "paper.rs"]
+mod paper;
+#[path = "preset_files.rs"]
+mod preset_files;
+#[path = "properties.rs"]
+mod properties;
+#[path = "quality.rs"]
+mod quality;
+#[path = "regressions.rs"]
+mod regressions;
+#[path = "snapshots.rs"]
+mod snapshots;
+#[path = "user_surfaces.rs"]
+mod user_surfaces;
+#[path = "validate.rs"]
+mod validate;
