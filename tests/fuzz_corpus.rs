@@ -1,15 +1,13 @@
 //! Replays the committed fuzz corpora (`fuzz/corpus/<target>/*`) on stable Rust.
 //!
 //! Each file goes through the very function its cargo-fuzz target calls
-//! (`liemesh_fuzz::{mesher, triangulate, invariant_file}`, from `fuzz/src/lib.rs`, which this
-//! test includes as the module `fuzz_checks`), so the bytes are decoded the same way and the
+//! (`liemesh_fuzz::{mesher, triangulate, invariant_file}`, from `fuzz/src/lib.rs`, which the
+//! test suite includes as the module `fuzz_checks`), so the bytes are decoded the same way and the
 //! same output invariants are checked; a panic counts as a failure too.
 //! Every failing file is listed with its violation. See `fuzz/README.md`.
 
 // The fuzz targets' checks (see `tests/suite.rs`).
-use crate::fuzz_checks;
-
-use fuzz_checks::{Target, TARGETS};
+use crate::fuzz_checks::{Target, TARGETS};
 use std::panic::{catch_unwind, AssertUnwindSafe};
 use std::path::{Path, PathBuf};
 

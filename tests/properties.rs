@@ -26,9 +26,7 @@
 //! [`Topology`]: liemesh::quality::Topology
 
 // The fuzz targets' checks (see `tests/suite.rs`).
-use crate::fuzz_checks;
-
-use fuzz_checks::check_run;
+use crate::fuzz_checks::check_run;
 use liemesh::model::{Invariant, LieField};
 use liemesh::preset::{Preset, FIG46_INVARIANT};
 use liemesh::sample::CurveEnd;

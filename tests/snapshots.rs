@@ -6,9 +6,7 @@
 //! `INSTA_UPDATE=always cargo test --test suite snapshots::` and inspect the diff).
 
 // The fuzz targets' checks (see `tests/suite.rs`).
-use crate::fuzz_checks;
-
-use fuzz_checks::{check_chart, check_chart_delaunay};
+use crate::fuzz_checks::{check_chart, check_chart_delaunay};
 use liemesh::model::LieField;
 use liemesh::preset::Preset;
 use liemesh::quality::Topology;
