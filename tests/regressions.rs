@@ -485,6 +485,37 @@ fn a_flattened_ellipsoid_closes_from_its_pole_and_from_a_generic_point_with_defa
     }
 }
 
+/// The one-sheet hyperboloid `x² + y² − 100 z² = 1` (a waist of curvature radius 0.01)
+/// from a point off its waist, with defaults: the steps sized at `p0` cannot follow the
+/// waist's bend at the automatic `dt_min` (about 0.003), and 39 curves stopped there "at a
+/// singular point" with nothing saying the run was cut short, on a surface that has none
+/// (its normal `2 A p` vanishes only on the cone `pᵀ A p = 0`). They now end on the step
+/// floor, and the run says so; a cone's apex stays a singular point.
+#[test]
+fn a_flared_hyperboloid_stopped_at_its_waist_says_it_was_cut_short() {
+    use liemesh::NormalField;
+    let flared = Invariant::from_numbers(&[1.0, 1.0, -100.0, 0.0, 0.0, 0.0]).unwrap();
+    let field = LieField::<f64>::new(&flared);
+    let z: f64 = 0.0663;
+    let run = liemesh::run(
+        &field,
+        &MeshParams::at([(1.0 + 100.0 * z * z).sqrt(), 0.0, z]),
+    )
+    .unwrap();
+    let ends = run.samples.ends();
+    assert!(run.validation.is_valid(), "{}", run.validation);
+    assert_eq!(ends.singular, 0, "{ends:?}");
+    if !(run.validation.euler_characteristic == 0 && run.validation.boundary_loops == 2) {
+        assert!(ends.budget > 0, "{ends:?}");
+        let why = run.cut_short().join("; ");
+        assert!(why.contains("smaller dt_min"), "{why}");
+    }
+    assert!(field.is_regular_through([1.0, 0.0, 0.0]));
+    let cone =
+        LieField::<f64>::new(&Invariant::from_numbers(&[1.0, 1.0, -1.0, 0.0, 0.0, 0.0]).unwrap());
+    assert!(!cone.is_regular_through([0.6, 0.8, 1.0]));
+}
+
 /// A 25:1 oblate ellipsoid (`λ` = 1, 1, 625, flatter than the automatic clamps are fitted
 /// to) from generic points, with defaults: the rim bends more sharply (radius 0.0016) than
 /// the automatic `dt_min` (about 0.025) can follow. The curves stopped there "at a singular

@@ -75,6 +75,16 @@ pub trait NormalField<T: Scalar>: Sync {
         None
     }
 
+    /// Whether the field is known not to vanish anywhere on the surface through `p0`: the
+    /// surface then has no singular point, and a curve whose steps cannot follow its bend even
+    /// at `dt_min` (the waist of a sharply flared hyperboloid, the rim of a flat ellipsoid)
+    /// ends on the step floor, which the run reports as cut short by a budget, not as at a
+    /// singular point. The default says so for an ellipsoid the field knows
+    /// ([`Self::semi_axes_through`]) and otherwise `false`, which is always safe.
+    fn is_regular_through(&self, p0: [f64; 3]) -> bool {
+        self.semi_axes_through(p0).is_some()
+    }
+
     /// Whether the field is exactly the gradient of a polynomial of degree at most three, as
     /// every integrable invariant's field is. The drift-free chord is exact on such a field
     /// (Simpson's rule integrates its quadratic `v·dp` exactly). On any other integrable field
@@ -105,6 +115,9 @@ impl<T: Scalar, F: NormalField<T> + ?Sized> NormalField<T> for &F {
     }
     fn semi_axes_through(&self, p0: [f64; 3]) -> Option<[f64; 3]> {
         (**self).semi_axes_through(p0)
+    }
+    fn is_regular_through(&self, p0: [f64; 3]) -> bool {
+        (**self).is_regular_through(p0)
     }
     fn has_cubic_potential(&self) -> bool {
         (**self).has_cubic_potential()
@@ -213,6 +226,11 @@ impl<T: Scalar> LieField<T> {
     }
 }
 
+/// A quadric's level `c` (for `A` scaled to entries of at most one) counts as clear of zero
+/// from this many times `|p0|²`: a `p0` on a cone put there in `f64` gives `c` of about
+/// 10⁻¹⁶ `|p0|²`.
+const REGULAR_LEVEL: f64 = 1e-9;
+
 #[inline(always)]
 fn mat_vec<T: Scalar>(m: &Mat3<T>, p: &Vec3<T>) -> Vec3<T> {
     Vec3::new(m[0].dot(p), m[1].dot(p), m[2].dot(p))
@@ -281,6 +299,17 @@ impl<T: Scalar> NormalField<T> for LieField<T> {
             .map(|&l| (c / l).sqrt())
             .fold(None, |m: Option<f64>, x| Some(m.map_or(x, |m| m.max(x))));
         size.filter(|s| s.is_finite() && *s > 0.0)
+    }
+
+    /// For a quadric other than a cone (`pᵀ A p = c` with `c` clear of zero: every ellipsoid,
+    /// hyperboloid and elliptic cylinder), `true`: its gradient `2 A p` vanishes only where
+    /// `pᵀ A p = 0`. A cone's apex is a singular point; other fields may have them.
+    fn is_regular_through(&self, p0: [f64; 3]) -> bool {
+        self.quadric_through(p0).is_some_and(|(_, c)| {
+            // `A` is scaled to entries of at most one, so `|c| ≤ 3 |p0|²`; a cone's `p0` gives
+            // a `c` of rounding size.
+            c.abs() > REGULAR_LEVEL * p0.iter().map(|x| x * x).sum::<f64>()
+        })
     }
 
     /// For a quadric that is an ellipsoid (every eigenvalue `λ` of `A` of the sign of `c`),

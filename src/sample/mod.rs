@@ -40,8 +40,9 @@ pub enum CurveEnd {
     Singular,
     /// A budget ran out: points, steps per curve, Newton's iterations for a chord at every
     /// length tried ([`StepStop::NoChord`](crate::trace::StepStop::NoChord)), or the step
-    /// floor `dt_min` on a surface known to have no singular point (an ellipsoid's rim bending
-    /// more sharply than that step can follow).
+    /// floor `dt_min` on a surface known to have no singular point
+    /// ([`NormalField::is_regular_through`]: an ellipsoid's rim or a flared hyperboloid's
+    /// waist bending more sharply than that step can follow).
     Budget,
 }
 
@@ -320,7 +321,7 @@ pub(crate) fn sample_resolved<T: Scalar, F: NormalField<T>>(
             hit_point_budget: false,
         },
         pos: vec![params.p0],
-        no_singular_point: field.semi_axes_through(params.p0).is_some(),
+        no_singular_point: field.is_regular_through(params.p0),
         nrm: vec![n0.to_f64()],
         chart: vec![[0.0, 0.0]],
         live: Vec::new(),
@@ -397,8 +398,8 @@ struct Sampler<'a, T, F> {
     max_drift: f64,
     /// Where progress is reported (every [`SAMPLING_REPORT_EVERY`] passes of [`Self::run`]).
     observe: &'a dyn Fn(Progress),
-    /// Whether the field knows its surface has no singular point (an ellipsoid's,
-    /// [`NormalField::semi_axes_through`]): a step that cannot follow the bend at `dt_min`
+    /// Whether the field knows its surface has no singular point
+    /// ([`NormalField::is_regular_through`]): a step that cannot follow the bend at `dt_min`
     /// then ends its curve on the step floor ([`CurveEnd::Budget`]), not at a singular point.
     no_singular_point: bool,
 }
@@ -477,8 +478,9 @@ impl<T: Scalar, F: NormalField<T>> Sampler<'_, T, F> {
         // A step clamped at the smallest length that still turns the normal by more than
         // twice the band's top is at a singular point (a cone's apex): the field's curvature
         // grows without bound there, and the next step would jump across it. On a surface
-        // known to have none (an ellipsoid flatter than the fitted clamps), it is a rim
-        // sharper than `dt_min` resolves: the step floor ended the curve, and the run says so.
+        // known to have none, it is a bend sharper than `dt_min` resolves (the rim of an
+        // ellipsoid flatter than the fitted clamps, a sharply flared hyperboloid's waist): the
+        // step floor ended the curve, and the run says so.
         if step.limit == StepLimit::Clamped
             && len <= self.params.dt_min * (1.0 + 1e-9)
             && step.alpha_predicted > SINGULAR_TURN * self.params.beta_max.radians()
