@@ -16,45 +16,25 @@
 #[path = "../fuzz/src/lib.rs"]
 mod fuzz_checks;
 
-#[path = "audit_field.rs"]
 mod audit_field;
-#[path = "audit_jvp.rs"]
 mod audit_jvp;
-#[path = "audit_prediction.rs"]
 mod audit_prediction;
-#[path = "audit_scalars.rs"]
 mod audit_scalars;
-#[path = "classes.rs"]
 mod classes;
-#[path = "cli.rs"]
 mod cli;
-#[path = "cli_batch.rs"]
 mod cli_batch;
-#[path = "cli_bench.rs"]
 mod cli_bench;
-#[path = "derivatives.rs"]
 mod derivatives;
-#[path = "engine.rs"]
 mod engine;
-#[path = "errors.rs"]
 mod errors;
-#[path = "fuzz_corpus.rs"]
 mod fuzz_corpus;
-#[path = "paper.rs"]
 mod paper;
-#[path = "preset_files.rs"]
 mod preset_files;
-#[path = "properties.rs"]
 mod properties;
-#[path = "quality.rs"]
 mod quality;
-#[path = "regressions.rs"]
 mod regressions;
-#[path = "snapshots.rs"]
 mod snapshots;
-#[path = "user_surfaces.rs"]
 mod user_surfaces;
-#[path = "validate.rs"]
 mod validate;
 
 /// Every `.rs` file of `tests/` is a module above: with `autotests = false`, a file left out
