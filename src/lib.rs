@@ -293,6 +293,8 @@ pub fn run_observed<T: Scalar, F: NormalField<T>>(
     let (points, curves) = (samples.points.len(), samples.curves.len());
     observe(Progress::at(Stage::Triangulating, points, curves, 0));
     let improve = params.mode == Mode::Default;
+    // The axis of the hole the field knows, which no face may meet.
+    let axis = field.hole_through(params.p0).map(|h| h.axis());
     // A mesh that is stitched is flipped to surface Delaunay once it is whole, not as a chart.
     let (mut mesh, chart) =
         triangulate::triangulate(&samples, params.close, improve && !params.close)?;
@@ -307,7 +309,7 @@ pub fn run_observed<T: Scalar, F: NormalField<T>>(
         ));
         let stitched = triangulate::stitch(field, params, &samples, &mut mesh, &mut vertices);
         if improve {
-            triangulate::flip_to_surface_delaunay(&mut mesh);
+            triangulate::flip_to_surface_delaunay(&mut mesh, axis);
         }
         stitched
     } else {
@@ -354,6 +356,9 @@ pub fn run_observed<T: Scalar, F: NormalField<T>>(
         curves,
         mesh.triangles.len(),
     ));
+    // No face may span the hole the field knows: the stitching and the flips hold to that,
+    // and a face that relaxation or refinement carried across it goes here.
+    let across = triangulate::drop_across(&mut mesh, axis);
     // Pinched vertices are cut apart and only the main component is kept. The validation
     // finds both (and the faces it leaves out of its topology, which those passes may drop),
     // so on the usual mesh, which has none of them, the passes are skipped.
@@ -390,8 +395,9 @@ pub fn run_observed<T: Scalar, F: NormalField<T>>(
         (validation, boundary) = mesh::validate_with_boundary(&mesh);
     }
     untangled.pinned = pinned;
+    untangled.removed += across;
     let mut stitched = stitched;
-    stitched.holes = triangulate::holes(&samples, params, &mesh, &boundary);
+    stitched.holes = triangulate::holes(&samples, params, &mesh, &boundary, axis);
     triangulate::drop_unused(&mut mesh, &mut vertices);
     // The refinement's count of faces over the bound, on the mesh as returned.
     let mut refinement = refinement;

@@ -134,7 +134,8 @@ pub struct MeshParams {
     /// extent scales.
     pub dt_min: Option<f64>,
     /// Largest step; automatic: half the step scale, at most a twelfth of `max_radius`, and
-    /// on an ellipsoid up to 16:1 at most its shortest semi-axis.
+    /// on an ellipsoid up to 16:1 at most its shortest semi-axis, round a hole the field knows
+    /// ([`NormalField::hole_through`]) at most the waist's narrowest radius.
     pub dt_max: Option<f64>,
     /// β_min: smallest normal turn per step.
     #[cfg_attr(feature = "serde", serde(rename = "beta_min_deg"))]
@@ -433,12 +434,18 @@ impl MeshParams {
         // Only up to FITTED_FLATNESS: flatter ones, meshed with isotropic triangles small
         // enough for the rim, run for tens of seconds into the stitching budget; they keep
         // the clamps of `p0` and end in an error that names `dt_max`, or cut short.
+        // Round a hole the field knows (a band's waist), no step longer than the waist's
+        // narrowest radius either: from a nearly flat flange of a 100:1 hyperboloid, steps
+        // sized at `p0` went round the waist in a hexagon. (Letting the steps shrink to the
+        // waist's bend as well took the curves through a 100:1 waist, where the fronts then
+        // met and left the flange a disc with a wedge open, instead of a band round the
+        // waist cut short there: docs/status.md.)
         let (thickness, sharpest) = field
             .semi_axes_through(self.p0)
             .filter(|[s0, _, s2]| *s2 <= FITTED_FLATNESS * *s0)
-            .map_or((f64::INFINITY, f64::INFINITY), |[s0, _, s2]| {
-                (s0, s0 * s0 / s2)
-            });
+            .map(|[s0, _, s2]| (s0, s0 * s0 / s2))
+            .or_else(|| Some((field.hole_through(self.p0)?.waist(), f64::INFINITY)))
+            .unwrap_or((f64::INFINITY, f64::INFINITY));
         let integrable = shape.is_integrable();
         let max_radius = self.max_radius.unwrap_or(
             if integrable {

@@ -7,6 +7,7 @@
 //! | ellipsoids (any scale, any axis order, any pose) | valid, closed, χ = 2 |
 //! | elliptic cylinders along any axis, in any pose | valid; a band (χ = 0, two boundary loops) in at least 95% of cases |
 //! | hyperboloids of one sheet, in any pose | valid; a band (χ = 0, two boundary loops) in at least 95% of cases |
+//! | flared hyperboloids of one sheet (flange 4:1 to 10:1 against the waist), in any pose, from the waist out onto the flange | valid, no face across the waist; a band, or the run says where it stopped short (a hole or a budget) |
 //! | hyperboloids of two sheets, in any pose | valid, one sheet: a disc |
 //! | cones, in any pose | valid; one nappe (χ = 1 with one loop, or χ = 0 with two: meeting at or stopping short of the apex) in at least 95% of cases |
 //! | linear invariants with non-zero angles (non-integrable) | valid, at least 200 triangles; at most a fifth `MeshError::Empty` |
@@ -353,6 +354,28 @@ fn quadric_class(seed: u64, signs: [f64; 3], level: f64, shape: Shape, name: &st
                 shape,
                 &format!("{name} λ {lambda:?} angles {angles:?}"),
             )?;
+            // A band goes round its axis (the λ that is not of the level's sign): the field
+            // knows it, and no face spans the waist across it.
+            if let Some(k) = (0..3)
+                .find(|&k| lambda[k] * level <= 0.0)
+                .filter(|_| matches!(shape, Shape::Band))
+            {
+                let mut e = [0.0; 3];
+                e[k] = 1.0;
+                let axis = apply_transposed(&r, e);
+                let hole = field.hole_through(apply_transposed(&r, p0));
+                let [a, b] = hole.map(|h| h.axis()).unwrap_or_default();
+                let along = sub(b, a);
+                let parallel = norm3(cross3(along, axis)) <= 1e-9 * norm3(along);
+                prop_assert!(
+                    hole.is_some() && parallel,
+                    "{name}: hole {hole:?}, axis {axis:?}"
+                );
+                let across = (run.mesh.triangles.iter())
+                    .filter(|t| meets_axis(t.map(|v| run.mesh.vertices[v as usize]), axis))
+                    .count();
+                prop_assert_eq!(across, 0, "{}: faces across the waist", name);
+            }
             // Integrable: the vertices stay on the quadric to rounding (relative to F's size).
             let drift = quadric_drift(&run.mesh, lambda, &r, level);
             let size = (0..3).map(|k| lambda[k].abs() * p0[k] * p0[k]).sum::<f64>();
@@ -361,6 +384,47 @@ fn quadric_class(seed: u64, signs: [f64; 3], level: f64, shape: Shape, name: &st
         })
         .unwrap();
     cases
+}
+
+/// Whether the triangle `t` meets the line through the origin along `axis` (the signs of
+/// the line against its three edges are not mixed; in floating point, with a margin that
+/// counts grazing as meeting).
+fn meets_axis(t: [[f64; 3]; 3], axis: [f64; 3]) -> bool {
+    let side = |k: usize| {
+        let (p, q) = (t[k], t[(k + 1) % 3]);
+        // The moment of the line through the origin along `axis` against edge p→q.
+        let v = dot3(axis, cross3(p, q));
+        let scale = norm3(axis) * norm3(p) * norm3(q);
+        if v > 1e-12 * scale {
+            1
+        } else if v < -1e-12 * scale {
+            -1
+        } else {
+            0
+        }
+    };
+    let s = [side(0), side(1), side(2)];
+    !(s.contains(&1) && s.contains(&-1))
+}
+
+fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+}
+
+fn cross3(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ]
+}
+
+fn dot3(a: [f64; 3], b: [f64; 3]) -> f64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+
+fn norm3(a: [f64; 3]) -> f64 {
+    dot3(a, a).sqrt()
 }
 
 /// The point on `Σ λₖ xₖ² = level` along direction `d` from the origin (for a cone,
@@ -411,6 +475,57 @@ fn one_sheet_hyperboloids_are_bands() {
             "one-sheet hyperboloid",
         )
     });
+}
+
+/// Cases of the flared class unless `PROPTEST_CASES` says otherwise: its runs take seconds.
+const FLARED_CASES: u32 = 6;
+
+/// `x² + y² − c z² = 1` with `c` from 16 to 100, turned by a random pose, from `p0` at height
+/// `f / √c` (f from 0.2 to 5: from beside the waist far out onto the flange) at a random
+/// angle round the axis. Not yet always a band (docs/status.md, "Flared one-sheet
+/// hyperboloids"), but never closed off across the waist, and never short of a band without
+/// saying so.
+#[test]
+fn flared_one_sheet_hyperboloids_never_span_their_waist() {
+    let strategy = (
+        16.0f64..100.0,
+        0.2f64..5.0,
+        0.0f64..std::f64::consts::TAU,
+        pose(),
+    );
+    let mut runner = runner(0xf1a);
+    if std::env::var_os("PROPTEST_CASES").is_none() {
+        runner = TestRunner::new(Config {
+            cases: FLARED_CASES,
+            ..runner.config().clone()
+        });
+    }
+    runner
+        .run(&strategy, |(c, f, turn, angles)| {
+            let lambda = [1.0, 1.0, -c];
+            let r = rotation(angles);
+            let field = posed(lambda, angles);
+            let z = f / c.sqrt();
+            let rho = (1.0 + c * z * z).sqrt();
+            let p0 = [rho * turn.cos(), rho * turn.sin(), z];
+            let what = format!("c {c}, f {f}, turn {turn}, angles {angles:?}");
+            let run = run(&field, &MeshParams::at(apply_transposed(&r, p0)))
+                .map_err(|e| TestCaseError::fail(format!("{what}: {e}")))?;
+            let validation = run.mesh.validate();
+            prop_assert!(validation.is_valid(), "{what}: {validation}");
+            let axis = apply_transposed(&r, [0.0, 0.0, 1.0]);
+            let across = (run.mesh.triangles.iter())
+                .filter(|t| meets_axis(t.map(|v| run.mesh.vertices[v as usize]), axis))
+                .count();
+            prop_assert_eq!(across, 0, "{}: faces across the waist", what);
+            let band = validation.euler_characteristic == 0 && validation.boundary_loops == 2;
+            prop_assert!(
+                band || run.stitched.holes > 0 || !run.cut_short().is_empty(),
+                "{what}: {validation}, no hole reported and not cut short"
+            );
+            Ok(())
+        })
+        .unwrap();
 }
 
 #[test]

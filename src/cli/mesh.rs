@@ -616,8 +616,9 @@ fn print_summary(r: &Report, mesh: Option<&Path>, report: Option<&Path>) {
     if holes > 0 {
         println!(
             "  holes      {holes} boundary loop{} where the surface goes on (none of its \
-             vertices at the radius, the box, a singular point or a budget): fronts that met \
-             and were not stitched, or a swept surface cut back",
+             vertices at the radius, the box, a singular point or a budget; or, round a band's \
+             waist, a loop that does not go round it): fronts that met and were not stitched, \
+             or a swept surface cut back",
             if holes == 1 { "" } else { "s" }
         );
     }

@@ -183,6 +183,21 @@ pub(crate) fn is_collinear<O: Orient>(o: O, a: P3, b: P3, c: P3) -> bool {
     drop_axis(o, a, b, c).is_none()
 }
 
+/// Whether the closed triangle `t` meets the infinite line through the two distinct points
+/// `line`, decided exactly: the line passes each edge on one side (Plücker's test), and it
+/// meets the triangle unless it passes two edges on opposite sides. A triangle in a plane
+/// with the line (every sign zero) counts as meeting it, and so does a non-finite corner: a
+/// line a mesh must keep off is better kept off such faces too.
+pub(crate) fn triangle_meets_line(t: Tri, line: [P3; 2]) -> bool {
+    if !finite(&t) {
+        return true;
+    }
+    let o = Checked;
+    let side = |k: usize| o.orient3d(line[0], line[1], t[k], t[(k + 1) % 3]);
+    let s = [side(0), side(1), side(2)];
+    !(s.contains(&1) && s.contains(&-1))
+}
+
 fn finite(t: &Tri) -> bool {
     t.iter().flatten().all(|x| x.is_finite())
 }
@@ -456,6 +471,43 @@ fn folded_onto<O: Orient>(o: O, f: &O::Plane, a: P3, b: P3, c: P3, d: P3) -> boo
 
 #[cfg(test)]
 mod tests {
+    #[test]
+    fn a_line_meets_the_triangles_it_passes_through_and_no_other() {
+        use super::triangle_meets_line;
+        let axis = [[0.0, 0.0, -1.0], [0.0, 0.0, 2.0]];
+        // Across the axis, through a corner, along an edge: met.
+        assert!(triangle_meets_line(
+            [[1.0, 0.0, 0.0], [-1.0, 1.0, 0.0], [-1.0, -1.0, 0.5]],
+            axis
+        ));
+        assert!(triangle_meets_line(
+            [[0.0, 0.0, 3.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]],
+            axis
+        ));
+        assert!(triangle_meets_line(
+            [[1.0, 0.0, 0.0], [-1.0, 0.0, 0.0], [0.0, 1.0, 0.0]],
+            axis
+        ));
+        // Beside the axis, and a face standing beside it: not met.
+        assert!(!triangle_meets_line(
+            [[1.0, 0.0, 0.0], [2.0, 1.0, 0.0], [1.0, 1.0, 1.0]],
+            axis
+        ));
+        assert!(!triangle_meets_line(
+            [[1.0, 0.0, 0.0], [1.0, 1.0, 0.0], [1.0, 0.0, 1.0]],
+            axis
+        ));
+        // In a plane with the axis: counted as meeting it, wherever it lies.
+        assert!(triangle_meets_line(
+            [[1.0, 0.0, 0.0], [2.0, 0.0, 0.0], [1.0, 0.0, 1.0]],
+            axis
+        ));
+        assert!(triangle_meets_line(
+            [[f64::NAN, 0.0, 0.0], [2.0, 1.0, 0.0], [1.0, 1.0, 1.0]],
+            axis
+        ));
+    }
+
     use super::*;
     use crate::geom::predicates::InRange;
     use crate::geom::rng::XorShift64;

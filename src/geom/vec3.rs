@@ -46,6 +46,20 @@ pub(crate) fn dist(a: [f64; 3], b: [f64; 3]) -> f64 {
     dot(d, d).sqrt()
 }
 
+/// The signed angle from `p` to `q` about the line through the two points `axis`, in
+/// radians in (−π, π], counter-clockwise seen from `axis[1]` looking back at `axis[0]`: the
+/// turn of a loop round the axis is the sum over its edges.
+pub(crate) fn turn_about([o, far]: [[f64; 3]; 2], p: [f64; 3], q: [f64; 3]) -> f64 {
+    let unit = normalize(sub(far, o));
+    let across = |x: [f64; 3]| {
+        let d = sub(x, o);
+        let h = dot(d, unit);
+        [d[0] - h * unit[0], d[1] - h * unit[1], d[2] - h * unit[2]]
+    };
+    let (p, q) = (across(p), across(q));
+    dot(cross(p, q), unit).atan2(dot(p, q))
+}
+
 /// The hasher of the tables keyed by small integers (vertex pairs, grid cells): rustc-hash's
 /// `FxBuildHasher`. SipHash, the standard one, dominated the profiles of those tables.
 ///

@@ -85,6 +85,18 @@ pub trait NormalField<T: Scalar>: Sync {
         self.semi_axes_through(p0).is_some()
     }
 
+    /// The hole the surface through `p0` goes round, when the field knows it: a one-sheet
+    /// hyperboloid's or an elliptic cylinder's waist, a torus's ring ([`Hole`]). The mesh
+    /// then keeps every triangle off the hole's axis (the stitching, the flips and the last
+    /// check of a run, [`crate::run`]), a boundary loop that does not go round the axis is
+    /// reported as a hole ([`crate::triangulate::Stitched::holes`]), and no automatic step is
+    /// longer than the waist's narrowest radius (from a flat flange, steps sized at `p0` would
+    /// go round it in a hexagon). The default, `None`, does none of this.
+    fn hole_through(&self, p0: [f64; 3]) -> Option<Hole> {
+        let _ = p0;
+        None
+    }
+
     /// Whether the field is exactly the gradient of a polynomial of degree at most three, as
     /// every integrable invariant's field is. The drift-free chord is exact on such a field
     /// (Simpson's rule integrates its quadratic `v·dp` exactly). On any other integrable field
@@ -119,8 +131,47 @@ impl<T: Scalar, F: NormalField<T> + ?Sized> NormalField<T> for &F {
     fn is_regular_through(&self, p0: [f64; 3]) -> bool {
         (**self).is_regular_through(p0)
     }
+    fn hole_through(&self, p0: [f64; 3]) -> Option<Hole> {
+        (**self).hole_through(p0)
+    }
     fn has_cubic_potential(&self) -> bool {
         (**self).has_cubic_potential()
+    }
+}
+
+/// The hole a surface goes round (a band's waist, a torus's ring), as a field knows it
+/// ([`NormalField::hole_through`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Hole {
+    axis: [[f64; 3]; 2],
+    waist: f64,
+}
+
+impl Hole {
+    /// The hole whose axis is the line through the two distinct points `axis` (a line the
+    /// surface never meets), round which the surface is at least `waist` wide (its narrowest
+    /// radius about the axis); `None` unless the points are finite and distinct and `waist`
+    /// finite and positive.
+    ///
+    /// ```
+    /// use liemesh::model::Hole;
+    /// // A torus about the z axis, ring radius 2, tube radius 0.5.
+    /// let hole = Hole::new([[0.0; 3], [0.0, 0.0, 1.0]], 1.5).unwrap();
+    /// assert_eq!(hole.waist(), 1.5);
+    /// assert!(Hole::new([[0.0; 3], [0.0; 3]], 1.5).is_none());
+    /// ```
+    pub fn new(axis: [[f64; 3]; 2], waist: f64) -> Option<Hole> {
+        let finite = axis.iter().flatten().all(|x| x.is_finite());
+        (finite && axis[0] != axis[1] && waist.is_finite() && waist > 0.0)
+            .then_some(Hole { axis, waist })
+    }
+    /// Two distinct points on the axis.
+    pub fn axis(&self) -> [[f64; 3]; 2] {
+        self.axis
+    }
+    /// The surface's narrowest radius about the axis.
+    pub fn waist(&self) -> f64 {
+        self.waist
     }
 }
 
@@ -209,6 +260,12 @@ impl<T: Scalar> LieField<T> {
     /// `c = p0ᵀ A p0`, both for `A` scaled to entries of order one (so that the eigen solver
     /// neither overflows nor underflows; the semi-axes `√(c / λ)` do not change).
     fn quadric_through(&self, p0: [f64; 3]) -> Option<([f64; 3], f64)> {
+        self.quadric_frame_through(p0).map(|(l, _, c)| (l, c))
+    }
+
+    /// [`Self::quadric_through`] with the unit eigenvectors of `A` beside its eigenvalues.
+    #[allow(clippy::type_complexity)]
+    fn quadric_frame_through(&self, p0: [f64; 3]) -> Option<([f64; 3], [[f64; 3]; 3], f64)> {
         if self.quadratic {
             return None;
         }
@@ -222,7 +279,8 @@ impl<T: Scalar> LieField<T> {
         let p = nalgebra::Vector3::from(p0);
         let c = p.dot(&(m * p));
         let eigen = nalgebra::SymmetricEigen::new(m);
-        Some(([0, 1, 2].map(|k| eigen.eigenvalues[k]), c))
+        let vectors = [0, 1, 2].map(|k| [0, 1, 2].map(|i| eigen.eigenvectors[(i, k)]));
+        Some(([0, 1, 2].map(|k| eigen.eigenvalues[k]), vectors, c))
     }
 }
 
@@ -312,6 +370,31 @@ impl<T: Scalar> NormalField<T> for LieField<T> {
         })
     }
 
+    /// For a quadric `pᵀ A p = c` (`c` clear of zero) with exactly one eigenvalue `λ` of `A`
+    /// not of the sign of `c` (a one-sheet hyperboloid, `λ c < 0`, or an elliptic cylinder,
+    /// `λ = 0`): the line through the origin along its eigenvector, on which `pᵀ A p = λ t²`
+    /// never equals `c`, and the waist's shorter semi-axis, the smallest `√(c / μ)` over the
+    /// other two eigenvalues `μ`.
+    fn hole_through(&self, p0: [f64; 3]) -> Option<Hole> {
+        if !self.is_regular_through(p0) {
+            return None;
+        }
+        let (eigenvalues, vectors, c) = self.quadric_frame_through(p0)?;
+        let across = |k: usize| eigenvalues[k] * c <= 0.0 || eigenvalues[k].abs() <= 1e-12;
+        let mut axes = (0..3).filter(|&k| across(k));
+        let (Some(k), None) = (axes.next(), axes.next()) else {
+            return None;
+        };
+        let waist = (0..3)
+            .filter(|&j| j != k)
+            .map(|j| (c / eigenvalues[j]).sqrt())
+            .fold(f64::INFINITY, f64::min);
+        // The second point as far out as `p0`, so that both are of the surface's scale.
+        let r = p0.iter().map(|x| x * x).sum::<f64>().sqrt();
+        let far = vectors[k].map(|x| x * r);
+        Hole::new([[0.0; 3], far], waist)
+    }
+
     /// For a quadric that is an ellipsoid (every eigenvalue `λ` of `A` of the sign of `c`),
     /// its semi-axes `√(c / λ)`, shortest first.
     fn semi_axes_through(&self, p0: [f64; 3]) -> Option<[f64; 3]> {
@@ -390,6 +473,38 @@ pub fn jacobian<T: Scalar, F: NormalField<T> + ?Sized>(field: &F, p: &Vec3<T>) -
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_band_quadric_knows_its_hole_and_no_other_quadric_has_one() {
+        let field = |n: [f64; 6]| LieField::<f64>::new(&Invariant::from_numbers(&n).unwrap());
+        let close = |a: f64, b: f64| (a - b).abs() <= 1e-12 * b.abs();
+        // x² + y² − 100 z² = 1: waist 1, axis z.
+        let flange = field([1.0, 1.0, -100.0, 0.0, 0.0, 0.0])
+            .hole_through([1.0, 0.0, 0.0])
+            .unwrap();
+        let [o, e] = flange.axis();
+        assert_eq!(o, [0.0; 3]);
+        assert!(e[0] == 0.0 && e[1] == 0.0 && e[2].abs() == 1.0);
+        assert!(close(flange.waist(), 1.0));
+        // x² + y²/4 = 1: the waist's shorter semi-axis.
+        let cylinder = field([1.0, 0.25, 0.0, 0.0, 0.0, 0.0])
+            .hole_through([0.0, 2.0, 0.0])
+            .unwrap();
+        assert!(close(cylinder.waist(), 1.0));
+        // An ellipsoid, a two-sheet hyperboloid, a cone, a twisted field: none.
+        assert!(field([1.0, 4.0, 16.0, 0.0, 0.0, 0.0])
+            .hole_through([1.0, 0.0, 0.0])
+            .is_none());
+        assert!(field([1.0, 1.0, -1.0, 0.0, 0.0, 0.0])
+            .hole_through([0.0, 0.0, 2.0])
+            .is_none());
+        assert!(field([1.0, 1.0, -1.0, 0.0, 0.0, 0.0])
+            .hole_through([0.6, 0.8, 1.0])
+            .is_none());
+        assert!(field([1.0, 1.0, -1.0, 0.3, 0.5, 0.7])
+            .hole_through([1.0, 0.0, 0.0])
+            .is_none());
+    }
 
     #[test]
     fn jvp_matches_the_closed_form_derivative() {

@@ -13,7 +13,7 @@ mod formula;
 mod invariant;
 mod shape;
 
-pub use field::{jacobian, FnField, LieField, NormalField};
+pub use field::{jacobian, FnField, Hole, LieField, NormalField};
 pub use formula::{EveryScalar, FieldFormula, Formula};
 pub use invariant::{AngleReading, Invariant, InvariantError, InvariantKind, Lift, Mat3};
 pub use shape::{least_aligned_tangent, LocalShape, INTEGRABLE_DEFECT};

@@ -9,6 +9,7 @@
 //! replaces tilted further; flips that undo a fold (a face against the field normal) come
 //! first.
 
+use crate::geom::intersect::triangle_meets_line;
 use crate::geom::rows::rows_by_corner;
 use crate::geom::vec3::{cross, dot, sub, FastHash};
 use crate::par;
@@ -128,6 +129,8 @@ pub(super) struct HalfEdges {
     tri: Vec<[u32; 3]>,
     twin: Vec<u32>,
     out: Vec<u32>,
+    /// A line no flipped triangle may meet ([`crate::NormalField::hole_through`]).
+    pub(super) axis: Option<[[f64; 3]; 2]>,
 }
 
 #[inline]
@@ -155,7 +158,12 @@ impl HalfEdges {
     #[inline]
     pub(super) fn new(tri: Vec<[u32; 3]>, vertices: usize) -> Result<Self, Vec<[u32; 3]>> {
         match Self::links(&tri, vertices) {
-            Some((twin, out)) => Ok(HalfEdges { tri, twin, out }),
+            Some((twin, out)) => Ok(HalfEdges {
+                tri,
+                twin,
+                out,
+                axis: None,
+            }),
             None => Err(tri),
         }
     }
@@ -385,6 +393,15 @@ impl HalfEdges {
                 return false;
             }
         }
+        // Nor may it span the surface's hole: where a band's waist is seen from a flat
+        // flange, every corner's normal points along the axis, and a triangle across the
+        // waist agrees with them all.
+        if let Some(axis) = self.axis {
+            let meets = |t: [u32; 3]| triangle_meets_line(t.map(|v| points[v as usize]), axis);
+            if meets(new1) || meets(new2) {
+                return false;
+            }
+        }
         // The flipped pair must not fold over the old one (the quad must be convex enough)
         // unless it undoes a fold.
         let old_sum = {
@@ -608,10 +625,11 @@ pub(crate) fn flip_to_surface_delaunay(
     triangles: &mut Vec<[u32; 3]>,
     budget: usize,
     pinned: &[bool],
+    axis: Option<[[f64; 3]; 2]>,
 ) -> FlipPass {
     let max_visits = 20 * triangles.len() + 1000;
     let mut he = match HalfEdges::new(std::mem::take(triangles), points.len()) {
-        Ok(he) => he,
+        Ok(he) => HalfEdges { axis, ..he },
         Err(tri) => {
             *triangles = tri;
             return FlipPass {
@@ -909,7 +927,7 @@ mod tests {
         let p = rhombus();
         let n = vec![[0.0, 0.0, 1.0]; 4];
         let mut t = vec![[0, 1, 2], [0, 2, 3]];
-        let pass = flip_to_surface_delaunay(&p, &n, &mut t, 10, &[]);
+        let pass = flip_to_surface_delaunay(&p, &n, &mut t, 10, &[], None);
         assert_eq!((pass.flips, pass.folded), (1, Some(false)));
         let mut edges: Vec<_> = t
             .iter()
@@ -918,7 +936,10 @@ mod tests {
         edges.sort_unstable();
         assert!(edges.contains(&(1, 3)) || edges.contains(&(3, 1)));
         // Now Delaunay: a second pass changes nothing.
-        assert_eq!(flip_to_surface_delaunay(&p, &n, &mut t, 10, &[]).flips, 0);
+        assert_eq!(
+            flip_to_surface_delaunay(&p, &n, &mut t, 10, &[], None).flips,
+            0
+        );
     }
 
     #[test]
@@ -942,7 +963,7 @@ mod tests {
         let mut t = vec![[0, 1, 2], [0, 2, 3]];
         let tilt = |t: [u32; 3]| agreement(&p, &n, t).acos().to_degrees();
         assert!((tilt([0, 1, 2]) - 29.7).abs() < 0.1 && (tilt([0, 1, 3]) - 36.9).abs() < 0.1);
-        let pass = flip_to_surface_delaunay(&p, &n, &mut t, 10, &[]);
+        let pass = flip_to_surface_delaunay(&p, &n, &mut t, 10, &[], None);
         assert_eq!(pass.flips, 0);
         assert_eq!(t, vec![[0, 1, 2], [0, 2, 3]]);
     }
@@ -954,7 +975,7 @@ mod tests {
         let p = rhombus();
         let n = vec![[0.0, 0.0, -1.0]; 4];
         let mut t = vec![[0, 1, 2], [0, 2, 3]];
-        let pass = flip_to_surface_delaunay(&p, &n, &mut t, 10, &[]);
+        let pass = flip_to_surface_delaunay(&p, &n, &mut t, 10, &[], None);
         assert_eq!((pass.flips, pass.folded), (0, Some(true)));
         assert!(t.iter().all(|&t| against_field(&p, &n, t)));
     }
@@ -966,7 +987,7 @@ mod tests {
         let n = vec![[0.0, 0.0, 1.0]; 5];
         let mut t = vec![[0, 1, 2], [0, 2, 3], [0, 2, 4]];
         let before = t.clone();
-        let pass = flip_to_surface_delaunay(&p, &n, &mut t, 10, &[]);
+        let pass = flip_to_surface_delaunay(&p, &n, &mut t, 10, &[], None);
         assert_eq!((pass.flips, pass.folded), (0, None));
         assert_eq!(t, before);
     }

@@ -38,8 +38,11 @@ pub(crate) use crate::mesh::octahedron;
 pub use crate::mesh::{Mesh, Provenance};
 
 use crate::error::MeshError;
+use crate::geom::intersect::triangle_meets_line;
 use crate::geom::union_find::UnionFind;
-use crate::geom::vec3::{cross as cross3, dist as dist3, sub as sub3, wider_than};
+use crate::geom::vec3::{
+    cross as cross3, dist as dist3, sub as sub3, turn_about, wider_than, FastHash,
+};
 use crate::model::LocalShape;
 use crate::params::Resolved;
 use crate::sample::{CurveEnd, Samples};
@@ -47,6 +50,7 @@ use crate::scalar::{Scalar, Vec3};
 use crate::trace::StepConfig;
 use crate::NormalField;
 use spade::{ConstrainedDelaunayTriangulation, HasPosition, Point2, Triangulation as _};
+use std::collections::HashMap;
 
 /// The chart-1 triangulation, kept for audits (empty-circumcircle checks, snapshots).
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -116,7 +120,7 @@ pub fn triangulate<T: Scalar>(
     let mut all = triangles.clone();
     if improve {
         let budget = 8 * all.len() + 64;
-        flip::flip_to_surface_delaunay(&pos, &normals, &mut all, budget, &[]);
+        flip::flip_to_surface_delaunay(&pos, &normals, &mut all, budget, &[], None);
     }
     // Three points on a line in space (curves that ran straight along a degenerate field)
     // make a triangle of no area and no normal, however good it looks in the chart.
@@ -142,7 +146,8 @@ pub fn triangulate<T: Scalar>(
 /// relaxation moves each vertex towards its neighbours: on the far cap of a sphere traced from
 /// its pole, relaxing them unflipped left its 1% smallest angle at 24° (fig2) where flipping
 /// first gives 35.6°.
-pub(crate) fn flip_to_surface_delaunay(mesh: &mut Mesh) {
+/// No flip makes a triangle that meets `axis` ([`NormalField::hole_through`]).
+pub(crate) fn flip_to_surface_delaunay(mesh: &mut Mesh, axis: Option<[[f64; 3]; 2]>) {
     let budget = 8 * mesh.triangles.len() + 64;
     flip::flip_to_surface_delaunay(
         &mesh.vertices,
@@ -150,6 +155,7 @@ pub(crate) fn flip_to_surface_delaunay(mesh: &mut Mesh) {
         &mut mesh.triangles,
         budget,
         &[],
+        axis,
     );
 }
 
@@ -191,11 +197,18 @@ fn rim_of<T>(samples: &Samples<T>, pr: &Provenance) -> stitch::Rim {
 /// band's end (a cylinder's, at the box) lined with vertices of curves that merged there. (A
 /// hole of a few long edges beside the box is not on the rim: a thin cylinder's, four edges
 /// of 100 mesh edges each, one corner 1.5 longest steps from the box.)
+///
+/// Round a hole the field knows (`axis`, [`NormalField::hole_through`]), a loop that does
+/// not go round the axis and has a vertex off the rim is a hole as well, rim or not: a band
+/// whose mesh stopped short of closing round its waist (the fronts round a 100:1
+/// hyperboloid's flange met and left a wedge open out to the box) is a disc whose one loop
+/// runs along the box and then back where the surface goes on.
 pub(crate) fn holes<T>(
     samples: &Samples<T>,
     params: &Resolved,
     mesh: &Mesh,
     boundary: &[(u32, u32)],
+    axis: Option<[[f64; 3]; 2]>,
 ) -> usize {
     if boundary.is_empty() {
         return 0;
@@ -222,8 +235,11 @@ pub(crate) fn holes<T>(
             reach[k] = reach[k].max(length.min(params.dt_max));
         }
     }
-    // A loop is on the rim if any of its vertices is.
+    // A loop is on the rim if any of its vertices is; round a hole, it must also go round
+    // it unless all of its vertices are.
     let mut on_rim = vec![false; ends.len()];
+    let mut off_rim = vec![false; ends.len()];
+    let turn = axis.map(|axis| turns_about(mesh, boundary, axis));
     for (k, &v) in ends.iter().enumerate() {
         let ended = mesh.provenance.get(v as usize).is_some_and(|pr| {
             rim_of(samples, pr) != stitch::Rim::Open || pr.s >= params.max_radius - reach[k]
@@ -234,10 +250,40 @@ pub(crate) fn holes<T>(
             .is_some_and(|q| q.iter().any(|x| x.abs() >= params.bounding_box - reach[k]));
         let root = loops.find(k as u32) as usize;
         on_rim[root] |= ended || at_box;
+        off_rim[root] |= !(ended || at_box);
     }
+    // Each loop's turn about the axis: its boundary edges' angles summed.
+    let mut turns = vec![0.0f64; ends.len()];
+    if let Some(turn) = &turn {
+        for (&(a, _), &angle) in boundary.iter().zip(turn) {
+            turns[loops.find(index(a)) as usize] += angle;
+        }
+    }
+    let misses_hole =
+        |k: usize| turn.is_some() && off_rim[k] && turns[k].abs() < std::f64::consts::PI;
     (0..ends.len() as u32)
-        .filter(|&k| loops.find(k) == k && !on_rim[k as usize])
+        .filter(|&k| loops.find(k) == k && (!on_rim[k as usize] || misses_hole(k as usize)))
         .count()
+}
+
+/// The angle each edge of `boundary` turns about `axis`, in the direction of the triangle it
+/// bounds (a boundary loop that goes once round the axis sums to ±2π, one that does not to
+/// 0, for edges that each turn less than π, as edges of a mesh that keeps off the axis do).
+fn turns_about(mesh: &Mesh, boundary: &[(u32, u32)], axis: [[f64; 3]; 2]) -> Vec<f64> {
+    // Each boundary edge lies on one triangle, which says which way it runs.
+    let index: HashMap<(u32, u32), usize, FastHash> =
+        boundary.iter().enumerate().map(|(i, &e)| (e, i)).collect();
+    let at = |v: u32| mesh.vertices[v as usize];
+    let mut turns = vec![0.0; boundary.len()];
+    for t in &mesh.triangles {
+        for k in 0..3 {
+            let (a, b) = (t[k], t[(k + 1) % 3]);
+            if let Some(&i) = index.get(&(a.min(b), a.max(b))) {
+                turns[i] = turn_about(axis, at(a), at(b));
+            }
+        }
+    }
+    turns
 }
 
 /// Stitches the chart mesh where its fronts meet (see the `stitch` module): triangles
@@ -250,6 +296,37 @@ pub(crate) fn stitch<T: Scalar, F: NormalField<T>>(
     samples: &Samples<T>,
     mesh: &mut Mesh,
     vertices: &mut Vec<Vec3<T>>,
+) -> Stitched {
+    // Chart triangles across the surface's hole (a band's waist seen from a flat flange, where
+    // the chart is a disc) go first; the stitching then holds its own to the same line.
+    let axis = field.hole_through(params.p0).map(|h| h.axis());
+    let across = drop_across(mesh, axis);
+    let mut stitched = stitch_chart(field, params, samples, mesh, vertices, axis);
+    stitched.removed += across;
+    stitched
+}
+
+/// Removes the triangles of `mesh` that meet `axis` ([`NormalField::hole_through`]); returns
+/// how many.
+pub(crate) fn drop_across(mesh: &mut Mesh, axis: Option<[[f64; 3]; 2]>) -> usize {
+    let Some(axis) = axis else {
+        return 0;
+    };
+    let before = mesh.triangles.len();
+    let p = &mesh.vertices;
+    mesh.triangles
+        .retain(|t| !triangle_meets_line(t.map(|v| p[v as usize]), axis));
+    before - mesh.triangles.len()
+}
+
+/// [`stitch`] once the chart's triangles across `axis` are gone.
+fn stitch_chart<T: Scalar, F: NormalField<T>>(
+    field: &F,
+    params: &Resolved,
+    samples: &Samples<T>,
+    mesh: &mut Mesh,
+    vertices: &mut Vec<Vec3<T>>,
+    axis: Option<[[f64; 3]; 2]>,
 ) -> Stitched {
     // New points only on an integrable field: checked at p0 and at samples spread over the
     // run (a field may be integrable near p0 and not farther out).
@@ -269,6 +346,7 @@ pub(crate) fn stitch<T: Scalar, F: NormalField<T>>(
         new_points: integrable,
         well_shaped: true,
         ovaloid: field.semi_axes_through(params.p0).is_some(),
+        axis,
     };
     let (mut stitched, mut open) = stitch::stitch(mesh, vertices, &rim, &[], &growth);
     if open == 0 || !integrable {
@@ -284,9 +362,10 @@ pub(crate) fn stitch<T: Scalar, F: NormalField<T>>(
     };
     // The chart's mesh, triangulated once more for both retries below (unflipped, as the first
     // attempt's: the stitched mesh is flipped afterwards).
-    let Ok((chart_mesh, _)) = triangulate(samples, params.close, false) else {
+    let Ok((mut chart_mesh, _)) = triangulate(samples, params.close, false) else {
         return stitched;
     };
+    drop_across(&mut chart_mesh, axis);
     let mut again = chart_mesh.clone();
     let mut again_vertices = sample_vertices(samples, &again);
     let (again_stitched, again_open) =
@@ -1092,7 +1171,7 @@ mod tests {
             let (v, boundary) = crate::mesh::validate_with_boundary(&mesh);
             assert_eq!(v.is_closed(), closed, "{preset:?}: {v}");
             assert_eq!(
-                holes(&run.samples, &run.params, &mesh, &boundary),
+                holes(&run.samples, &run.params, &mesh, &boundary, None),
                 0,
                 "{preset:?}"
             );
@@ -1124,7 +1203,7 @@ mod tests {
             mesh.triangles.remove(first.min(second));
             let (_, boundary) = crate::mesh::validate_with_boundary(&mesh);
             assert_eq!(
-                holes(&run.samples, &run.params, &mesh, &boundary),
+                holes(&run.samples, &run.params, &mesh, &boundary, None),
                 2,
                 "{preset:?}"
             );

@@ -115,6 +115,7 @@ pub(crate) fn relax<T: Scalar, F: NormalField<T>>(
         &mut mesh.triangles,
         budget,
         pinned,
+        field.hole_through(params.p0).map(|h| h.axis()),
     );
     *vertices = pos;
 }

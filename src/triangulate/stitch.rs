@@ -89,10 +89,10 @@
 //! end are cut apart by removing the fewer triangles of the vertex.
 
 use super::proximity::{FaceGrid, PointGrid};
-use crate::geom::intersect::faces_intersect;
+use crate::geom::intersect::{faces_intersect, triangle_meets_line};
 use crate::geom::rows::{compressed_rows, rows_by_corner};
 use crate::geom::union_find::UnionFind;
-use crate::geom::vec3::{cross, dist, dot, sub, FastHash};
+use crate::geom::vec3::{cross, dist, dot, sub, turn_about, FastHash};
 use crate::mesh::{Mesh, Provenance};
 use crate::params::Mode;
 use crate::scalar::{Scalar, Vec3};
@@ -189,6 +189,9 @@ pub struct Stitched {
     /// touching at a vertex count as one): holes where the surface goes on and the mesh does
     /// not. On a surface integrable at `p0`, fronts that met and were not stitched; on a swept
     /// surface, also where it was cut back (its folds, or the sheet about to cross itself).
+    /// Round a hole the field knows ([`NormalField::hole_through`]), also each loop that does
+    /// not go round it and has a vertex off that rim: a band that did not close round its
+    /// waist.
     #[cfg_attr(feature = "serde", serde(default))]
     pub holes: usize,
 }
@@ -540,6 +543,10 @@ pub(crate) struct Growth<'f, T, F> {
     /// ([`Stitcher::bent_triangulation`]). Elsewhere a small loop can ring a whole missing
     /// handle (a tanglecube's), which a disc across it would close off.
     pub(crate) ovaloid: bool,
+    /// A line through a hole of the surface that no triangle may meet
+    /// ([`NormalField::hole_through`]): the stitching never closes a band off across its
+    /// waist.
+    pub(crate) axis: Option<[[f64; 3]; 2]>,
 }
 
 /// Stitches the boundary of `mesh` (triangles counter-clockwise about the field normals) to
@@ -1702,6 +1709,13 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
     /// it shares with them (exact).
     fn face_meets_nothing(&self, t: [u32; 3]) -> bool {
         let c = corners(&self.pos, t);
+        if self
+            .growth
+            .axis
+            .is_some_and(|axis| triangle_meets_line(c, axis))
+        {
+            return false;
+        }
         let (lo, hi) = bounds(&c);
         let mut hit = false;
         let mut visits = 0;
@@ -1841,6 +1855,28 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
         apart.then_some(out)
     }
 
+    /// Whether the loop `ring` is known to bound a disc of the surface, so that the disc may
+    /// be closed across a bend sharper than its triangles: on an ovaloid every loop does; round
+    /// a hole the field knows (a band), every loop that does not go round its axis. (A loop
+    /// that rings a missing handle of a surface the field knows nothing of, a tanglecube's,
+    /// must stay open.)
+    fn bounds_a_disc(&self, ring: &[u32]) -> bool {
+        if self.growth.ovaloid {
+            return true;
+        }
+        let Some(axis) = self.growth.axis else {
+            return false;
+        };
+        let m = ring.len();
+        let turn: f64 = (0..m)
+            .map(|i| {
+                let (p, q) = (ring[i], ring[(i + 1) % m]);
+                turn_about(axis, self.pos[p as usize], self.pos[q as usize])
+            })
+            .sum();
+        turn.abs() < std::f64::consts::PI
+    }
+
     /// Closes the boundary loops that are left, ear by ear (the best-shaped ear first), as
     /// long as the ears face the way the field does, meet nothing and cover no other vertex of
     /// the loop: the last few triangles where fronts met may have to be thin. Loops of at most
@@ -1885,7 +1921,7 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
                         // however far it tilts.
                         self.add(t);
                         added += 1;
-                    } else if let Some(ts) = (m > 3 && self.growth.ovaloid)
+                    } else if let Some(ts) = (m > 3 && self.bounds_a_disc(&ring))
                         .then(|| self.bent_triangulation(&ring))
                         .flatten()
                     {

@@ -39,7 +39,8 @@ const RELAX_AGAIN: usize = 3;
 pub struct Untangled {
     /// Vertices put back where they were before relaxation.
     pub reverted: usize,
-    /// Faces removed because they crossed others, or were cut off with them.
+    /// Faces removed because they crossed others, or were cut off with them, or met the axis
+    /// of the surface's hole ([`crate::model::Hole`]).
     pub removed: usize,
     /// Crossing face pairs left (0 unless the rounds ran out).
     pub left: usize,
