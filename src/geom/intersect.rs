@@ -17,7 +17,7 @@
 //!   that function for what counts as an intersection then.
 
 use super::predicates::{Checked, Orient, P3};
-use super::vec3::{cross, sub};
+use super::vec3::{cross, dot as dot3, sub};
 
 /// A triangle by its three corners.
 pub(crate) type Tri = [P3; 3];
@@ -191,6 +191,18 @@ pub(crate) fn is_collinear<O: Orient>(o: O, a: P3, b: P3, c: P3) -> bool {
 pub(crate) fn triangle_meets_line(t: Tri, line: [P3; 2]) -> bool {
     if !finite(&t) {
         return true;
+    }
+    // Most triangles lie far from the line: every point of a triangle is within its longest
+    // edge at the first corner of that corner, so a first corner farther from the line
+    // misses it (in floating point, with a margin far above the rounding of the distance).
+    let along = sub(line[1], line[0]);
+    let from = sub(t[0], line[0]);
+    let moment = cross(from, along);
+    let (ll, ff) = (dot3(along, along), dot3(from, from));
+    let distance2 = dot3(moment, moment) / ll;
+    let reach2 = dot3(sub(t[1], t[0]), sub(t[1], t[0])).max(dot3(sub(t[2], t[0]), sub(t[2], t[0])));
+    if distance2 > reach2 * (1.0 + 1e-6) + 1e-12 * ff && distance2.is_finite() {
+        return false;
     }
     let o = Checked;
     let side = |k: usize| o.orient3d(line[0], line[1], t[k], t[(k + 1) % 3]);
@@ -495,6 +507,16 @@ mod tests {
         ));
         assert!(!triangle_meets_line(
             [[1.0, 0.0, 0.0], [1.0, 1.0, 0.0], [1.0, 0.0, 1.0]],
+            axis
+        ));
+        // Far from the axis (decided before the exact test), and long enough to reach across
+        // it from a far corner (decided by it).
+        assert!(!triangle_meets_line(
+            [[5.0, 0.0, 0.0], [6.0, 0.0, 0.0], [5.0, 1.0, 9.0]],
+            axis
+        ));
+        assert!(triangle_meets_line(
+            [[5.0, 0.0, 0.0], [-5.0, 1.0, 0.0], [-5.0, -1.0, 0.0]],
             axis
         ));
         // In a plane with the axis: counted as meeting it, wherever it lies.
