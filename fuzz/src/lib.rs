@@ -404,7 +404,9 @@ pub fn mesher(data: &[u8]) -> Result<(), Violation> {
 ///   triangulations and the stitching added (triangles of no area in space are left out), and
 ///   its vertices are the run's working-precision vertices rounded to `f64`;
 /// - refinement ([`MeshParams::max_normal_error`]) counts the vertices it added and the faces
-///   of `field` it left over the bound correctly, and adds at most two faces per vertex.
+///   of `field` it left over the bound correctly, and adds at most two faces per vertex;
+/// - no face has the axis of a hole the field knows ([`NormalField::hole_through`]) pass
+///   through it.
 pub fn check_run(
     field: &impl NormalField<f64>,
     params: &MeshParams,
@@ -500,6 +502,33 @@ pub fn check_run(
         run.validation.boundary_loops,
         run.validation
     );
+    // No face meets the axis of a hole the field knows (a band's waist): such a face spans
+    // the hole. Decided here in floating point, independently of the mesher's exact test,
+    // and only for faces the axis passes clearly inside of.
+    if let Some(hole) = field.hole_through(params.p0) {
+        let [o, far] = hole.axis();
+        let along = sub3(far, o);
+        let norm = |x: [f64; 3]| (x[0] * x[0] + x[1] * x[1] + x[2] * x[2]).sqrt();
+        let inside = |t: &[u32; 3]| {
+            let c = t.map(|i| sub3(run.mesh.vertices[i as usize], o));
+            // The axis against edge p → q (Plücker), with a margin of rounding's order.
+            let side = |k: usize| {
+                let (p, q) = (c[k], c[(k + 1) % 3]);
+                let m = cross3(p, q);
+                let s = along[0] * m[0] + along[1] * m[1] + along[2] * m[2];
+                let margin = 1e-9 * norm(along) * norm(p) * norm(q);
+                (s > margin) as i8 - (s < -margin) as i8
+            };
+            let s = [side(0), side(1), side(2)];
+            s[0] != 0 && s[0] == s[1] && s[1] == s[2]
+        };
+        let across = run.mesh.triangles.iter().filter(|t| inside(t)).count();
+        ensure!(
+            across == 0,
+            "{across} faces span the hole: its axis {:?} passes through them",
+            hole.axis()
+        );
+    }
     ensure!(
         run.vertices.len() == run.mesh.vertices.len()
             && run
