@@ -24,6 +24,7 @@
 //! Cases come from a fixed seed per class so that the suite is reproducible;
 //! `PROPTEST_CASES=<n>` runs `n` cases per class and `PROPTEST_RNG_SEED=<n>` explores others.
 
+use crate::fuzz_checks::faces_across_axis;
 use liemesh::mesh::Mesh;
 use liemesh::model::{AngleReading, FnField, Invariant, LieField, NormalField};
 use liemesh::quality::Topology;
@@ -365,15 +366,14 @@ fn quadric_class(seed: u64, signs: [f64; 3], level: f64, shape: Shape, name: &st
                 let axis = apply_transposed(&r, e);
                 let hole = field.hole_through(apply_transposed(&r, p0));
                 let [a, b] = hole.map(|h| h.axis()).unwrap_or_default();
-                let along = sub(b, a);
-                let parallel = norm3(cross3(along, axis)) <= 1e-9 * norm3(along);
+                let along = &Vec3::from_f64(b) - &Vec3::from_f64(a);
+                let parallel =
+                    norm(along.cross(&Vec3::from_f64(axis))) <= 1e-9 * norm(along.clone());
                 prop_assert!(
                     hole.is_some() && parallel,
                     "{name}: hole {hole:?}, axis {axis:?}"
                 );
-                let across = (run.mesh.triangles.iter())
-                    .filter(|t| meets_axis(t.map(|v| run.mesh.vertices[v as usize]), axis))
-                    .count();
+                let across = faces_across_axis(&run.mesh, [[0.0; 3], axis]);
                 prop_assert_eq!(across, 0, "{}: faces across the waist", name);
             }
             // Integrable: the vertices stay on the quadric to rounding (relative to F's size).
@@ -384,47 +384,6 @@ fn quadric_class(seed: u64, signs: [f64; 3], level: f64, shape: Shape, name: &st
         })
         .unwrap();
     cases
-}
-
-/// Whether the triangle `t` meets the line through the origin along `axis` (the signs of
-/// the line against its three edges are not mixed; in floating point, with a margin that
-/// counts grazing as meeting).
-fn meets_axis(t: [[f64; 3]; 3], axis: [f64; 3]) -> bool {
-    let side = |k: usize| {
-        let (p, q) = (t[k], t[(k + 1) % 3]);
-        // The moment of the line through the origin along `axis` against edge p→q.
-        let v = dot3(axis, cross3(p, q));
-        let scale = norm3(axis) * norm3(p) * norm3(q);
-        if v > 1e-12 * scale {
-            1
-        } else if v < -1e-12 * scale {
-            -1
-        } else {
-            0
-        }
-    };
-    let s = [side(0), side(1), side(2)];
-    !(s.contains(&1) && s.contains(&-1))
-}
-
-fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
-}
-
-fn cross3(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
-}
-
-fn dot3(a: [f64; 3], b: [f64; 3]) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
-
-fn norm3(a: [f64; 3]) -> f64 {
-    dot3(a, a).sqrt()
 }
 
 /// The point on `Σ λₖ xₖ² = level` along direction `d` from the origin (for a cone,
@@ -514,9 +473,7 @@ fn flared_one_sheet_hyperboloids_never_span_their_waist() {
             let validation = run.mesh.validate();
             prop_assert!(validation.is_valid(), "{what}: {validation}");
             let axis = apply_transposed(&r, [0.0, 0.0, 1.0]);
-            let across = (run.mesh.triangles.iter())
-                .filter(|t| meets_axis(t.map(|v| run.mesh.vertices[v as usize]), axis))
-                .count();
+            let across = faces_across_axis(&run.mesh, [[0.0; 3], axis]);
             prop_assert_eq!(across, 0, "{}: faces across the waist", what);
             let band = validation.euler_characteristic == 0 && validation.boundary_loops == 2;
             prop_assert!(

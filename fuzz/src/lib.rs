@@ -503,26 +503,9 @@ pub fn check_run(
         run.validation
     );
     // No face meets the axis of a hole the field knows (a band's waist): such a face spans
-    // the hole. Decided here in floating point, independently of the mesher's exact test,
-    // and only for faces the axis passes clearly inside of.
+    // the hole.
     if let Some(hole) = field.hole_through(params.p0) {
-        let [o, far] = hole.axis();
-        let along = sub3(far, o);
-        let norm = |x: [f64; 3]| (x[0] * x[0] + x[1] * x[1] + x[2] * x[2]).sqrt();
-        let inside = |t: &[u32; 3]| {
-            let c = t.map(|i| sub3(run.mesh.vertices[i as usize], o));
-            // The axis against edge p → q (Plücker), with a margin of rounding's order.
-            let side = |k: usize| {
-                let (p, q) = (c[k], c[(k + 1) % 3]);
-                let m = cross3(p, q);
-                let s = along[0] * m[0] + along[1] * m[1] + along[2] * m[2];
-                let margin = 1e-9 * norm(along) * norm(p) * norm(q);
-                (s > margin) as i8 - (s < -margin) as i8
-            };
-            let s = [side(0), side(1), side(2)];
-            s[0] != 0 && s[0] == s[1] && s[1] == s[2]
-        };
-        let across = run.mesh.triangles.iter().filter(|t| inside(t)).count();
+        let across = faces_across_axis(&run.mesh, hole.axis());
         ensure!(
             across == 0,
             "{across} faces span the hole: its axis {:?} passes through them",
@@ -578,6 +561,27 @@ pub fn check_run(
         );
     }
     Ok(())
+}
+
+/// How many faces of `mesh` the line through the two points `axis` passes through, decided
+/// in floating point, independently of the mesher's exact test: the line against each edge
+/// (Plücker) with a margin of rounding's order, and only faces it passes clearly inside of.
+pub fn faces_across_axis(mesh: &Mesh, [o, far]: [[f64; 3]; 2]) -> usize {
+    let along = sub3(far, o);
+    let norm = |x: [f64; 3]| (x[0] * x[0] + x[1] * x[1] + x[2] * x[2]).sqrt();
+    let inside = |t: &[u32; 3]| {
+        let c = t.map(|i| sub3(mesh.vertices[i as usize], o));
+        let side = |k: usize| {
+            let (p, q) = (c[k], c[(k + 1) % 3]);
+            let m = cross3(p, q);
+            let s = along[0] * m[0] + along[1] * m[1] + along[2] * m[2];
+            let margin = 1e-9 * norm(along) * norm(p) * norm(q);
+            (s > margin) as i8 - (s < -margin) as i8
+        };
+        let s = [side(0), side(1), side(2)];
+        s[0] != 0 && s[0] == s[1] && s[1] == s[2]
+    };
+    mesh.triangles.iter().filter(|t| inside(t)).count()
 }
 
 /// Checks the sampler's output against `params`:

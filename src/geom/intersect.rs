@@ -483,56 +483,66 @@ fn folded_onto<O: Orient>(o: O, f: &O::Plane, a: P3, b: P3, c: P3, d: P3) -> boo
 
 #[cfg(test)]
 mod tests {
-    #[test]
-    fn a_line_meets_the_triangles_it_passes_through_and_no_other() {
-        use super::triangle_meets_line;
-        let axis = [[0.0, 0.0, -1.0], [0.0, 0.0, 2.0]];
-        // Across the axis, through a corner, along an edge: met.
-        assert!(triangle_meets_line(
-            [[1.0, 0.0, 0.0], [-1.0, 1.0, 0.0], [-1.0, -1.0, 0.5]],
-            axis
-        ));
-        assert!(triangle_meets_line(
-            [[0.0, 0.0, 3.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]],
-            axis
-        ));
-        assert!(triangle_meets_line(
-            [[1.0, 0.0, 0.0], [-1.0, 0.0, 0.0], [0.0, 1.0, 0.0]],
-            axis
-        ));
-        // Beside the axis, and a face standing beside it: not met.
-        assert!(!triangle_meets_line(
-            [[1.0, 0.0, 0.0], [2.0, 1.0, 0.0], [1.0, 1.0, 1.0]],
-            axis
-        ));
-        assert!(!triangle_meets_line(
-            [[1.0, 0.0, 0.0], [1.0, 1.0, 0.0], [1.0, 0.0, 1.0]],
-            axis
-        ));
-        // Far from the axis (decided before the exact test), and long enough to reach across
-        // it from a far corner (decided by it).
-        assert!(!triangle_meets_line(
-            [[5.0, 0.0, 0.0], [6.0, 0.0, 0.0], [5.0, 1.0, 9.0]],
-            axis
-        ));
-        assert!(triangle_meets_line(
-            [[5.0, 0.0, 0.0], [-5.0, 1.0, 0.0], [-5.0, -1.0, 0.0]],
-            axis
-        ));
-        // In a plane with the axis: counted as meeting it, wherever it lies.
-        assert!(triangle_meets_line(
-            [[1.0, 0.0, 0.0], [2.0, 0.0, 0.0], [1.0, 0.0, 1.0]],
-            axis
-        ));
-        assert!(triangle_meets_line(
-            [[f64::NAN, 0.0, 0.0], [2.0, 1.0, 0.0], [1.0, 1.0, 1.0]],
-            axis
-        ));
-    }
-
     use super::*;
     use crate::geom::predicates::InRange;
     use crate::geom::rng::XorShift64;
+
+    #[test]
+    fn a_line_meets_the_triangles_it_passes_through_and_no_other() {
+        let axis = [[0.0, 0.0, -1.0], [0.0, 0.0, 2.0]];
+        let cases: [(&str, Tri, bool); 9] = [
+            (
+                "across it",
+                [[1.0, 0.0, 0.0], [-1.0, 1.0, 0.0], [-1.0, -1.0, 0.5]],
+                true,
+            ),
+            (
+                "through a corner",
+                [[0.0, 0.0, 3.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]],
+                true,
+            ),
+            (
+                "along an edge",
+                [[1.0, 0.0, 0.0], [-1.0, 0.0, 0.0], [0.0, 1.0, 0.0]],
+                true,
+            ),
+            (
+                "beside it",
+                [[1.0, 0.0, 0.0], [2.0, 1.0, 0.0], [1.0, 1.0, 1.0]],
+                false,
+            ),
+            (
+                "standing beside it",
+                [[1.0, 0.0, 0.0], [1.0, 1.0, 0.0], [1.0, 0.0, 1.0]],
+                false,
+            ),
+            // Decided before the exact test, and by it from a far corner.
+            (
+                "far from it",
+                [[5.0, 0.0, 0.0], [6.0, 0.0, 0.0], [5.0, 1.0, 9.0]],
+                false,
+            ),
+            (
+                "reaching across it",
+                [[5.0, 0.0, 0.0], [-5.0, 1.0, 0.0], [-5.0, -1.0, 0.0]],
+                true,
+            ),
+            // Counted as meeting it, wherever they lie.
+            (
+                "in a plane with it",
+                [[1.0, 0.0, 0.0], [2.0, 0.0, 0.0], [1.0, 0.0, 1.0]],
+                true,
+            ),
+            (
+                "not finite",
+                [[f64::NAN, 0.0, 0.0], [2.0, 1.0, 0.0], [1.0, 1.0, 1.0]],
+                true,
+            ),
+        ];
+        for (what, t, meets) in cases {
+            assert_eq!(triangle_meets_line(t, axis), meets, "{what}");
+        }
+    }
 
     fn tri(a: [f64; 3], b: [f64; 3], c: [f64; 3]) -> Tri {
         [a, b, c]

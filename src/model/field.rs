@@ -289,6 +289,12 @@ impl<T: Scalar> LieField<T> {
 /// 10⁻¹⁶ `|p0|²`.
 const REGULAR_LEVEL: f64 = 1e-9;
 
+/// Whether a quadric's level `c` through `p0` (of `A` scaled to entries of at most one, so
+/// that `|c| ≤ 3 |p0|²`) is clear of zero: not a cone, whose `p0` gives a `c` of rounding size.
+fn clear_of_zero(c: f64, p0: [f64; 3]) -> bool {
+    c.abs() > REGULAR_LEVEL * p0.iter().map(|x| x * x).sum::<f64>()
+}
+
 #[inline(always)]
 fn mat_vec<T: Scalar>(m: &Mat3<T>, p: &Vec3<T>) -> Vec3<T> {
     Vec3::new(m[0].dot(p), m[1].dot(p), m[2].dot(p))
@@ -363,11 +369,8 @@ impl<T: Scalar> NormalField<T> for LieField<T> {
     /// hyperboloid and elliptic cylinder), `true`: its gradient `2 A p` vanishes only where
     /// `pᵀ A p = 0`. A cone's apex is a singular point; other fields may have them.
     fn is_regular_through(&self, p0: [f64; 3]) -> bool {
-        self.quadric_through(p0).is_some_and(|(_, c)| {
-            // `A` is scaled to entries of at most one, so `|c| ≤ 3 |p0|²`; a cone's `p0` gives
-            // a `c` of rounding size.
-            c.abs() > REGULAR_LEVEL * p0.iter().map(|x| x * x).sum::<f64>()
-        })
+        self.quadric_through(p0)
+            .is_some_and(|(_, c)| clear_of_zero(c, p0))
     }
 
     /// For a quadric `pᵀ A p = c` (`c` clear of zero) with exactly one eigenvalue `λ` of `A`
@@ -376,10 +379,10 @@ impl<T: Scalar> NormalField<T> for LieField<T> {
     /// never equals `c`, and the waist's shorter semi-axis, the smallest `√(c / μ)` over the
     /// other two eigenvalues `μ`.
     fn hole_through(&self, p0: [f64; 3]) -> Option<Hole> {
-        if !self.is_regular_through(p0) {
+        let (eigenvalues, vectors, c) = self.quadric_frame_through(p0)?;
+        if !clear_of_zero(c, p0) {
             return None;
         }
-        let (eigenvalues, vectors, c) = self.quadric_frame_through(p0)?;
         let across = |k: usize| eigenvalues[k] * c <= 0.0 || eigenvalues[k].abs() <= 1e-12;
         let mut axes = (0..3).filter(|&k| across(k));
         let (Some(k), None) = (axes.next(), axes.next()) else {

@@ -130,7 +130,7 @@ pub(super) struct HalfEdges {
     twin: Vec<u32>,
     out: Vec<u32>,
     /// A line no flipped triangle may meet ([`crate::NormalField::hole_through`]).
-    pub(super) axis: Option<[[f64; 3]; 2]>,
+    axis: Option<[[f64; 3]; 2]>,
 }
 
 #[inline]
