@@ -135,7 +135,8 @@ pub struct MeshParams {
     pub dt_min: Option<f64>,
     /// Largest step; automatic: half the step scale, at most a twelfth of `max_radius`, and
     /// on an ellipsoid up to 16:1 at most its shortest semi-axis, round a hole the field knows
-    /// ([`NormalField::hole_through`]) at most the waist's narrowest radius.
+    /// ([`NormalField::hole_through`]) between half the waist's narrowest radius and all of
+    /// it.
     pub dt_max: Option<f64>,
     /// β_min: smallest normal turn per step.
     #[cfg_attr(feature = "serde", serde(rename = "beta_min_deg"))]
@@ -440,11 +441,12 @@ impl MeshParams {
         // waist's bend as well took the curves through a 100:1 waist, where the fronts then
         // met and left the flange a disc with a wedge open, instead of a band round the
         // waist cut short there: docs/status.md.)
+        let waist = field.hole_through(self.p0).map(|h| h.waist());
         let (thickness, sharpest) = field
             .semi_axes_through(self.p0)
             .filter(|[s0, _, s2]| *s2 <= FITTED_FLATNESS * *s0)
             .map(|[s0, _, s2]| (s0, s0 * s0 / s2))
-            .or_else(|| Some((field.hole_through(self.p0)?.waist(), f64::INFINITY)))
+            .or_else(|| Some((waist?, f64::INFINITY)))
             .unwrap_or((f64::INFINITY, f64::INFINITY));
         let integrable = shape.is_integrable();
         let max_radius = self.max_radius.unwrap_or(
@@ -454,8 +456,14 @@ impl MeshParams {
                 AUTO_RADIUS_SWEPT
             } * scales.extent,
         );
+        // Round a hole, the girth sets the largest step as well as p0 does: at least what
+        // a circular cylinder of the waist's radius would have. Near a sharp waist the step
+        // scale at p0 follows the bend along the axis, a small fraction of the girth, and
+        // steps that short round it left a hole where the fronts met across the bend.
+        let girth = waist.map_or(0.0, |w| AUTO_DT_MAX * w);
         let dt_max = self.dt_max.unwrap_or(
             (AUTO_DT_MAX * scales.step)
+                .max(girth)
                 .min(thickness)
                 .min(max_radius / STEPS_ACROSS_RADIUS),
         );

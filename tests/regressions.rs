@@ -542,6 +542,31 @@ fn a_flared_hyperboloid_from_its_flange_is_never_closed_off_across_its_waist() {
     }
 }
 
+/// `[1, 1, −c]` from beside its waist, `(0.8 r, 0.6 r, 0.3 / √c)`, with defaults: the step
+/// scale there follows the waist's bend along the axis (radius `1/c`), so the automatic
+/// `dt_max` was a tenth of the waist's radius and more, and the curves round the girth,
+/// many times the band needs, met across the bend and left a hole (c = 30: 38,875
+/// triangles, χ = −1; c = 100: 32,195, χ = −1). Round a hole the largest step is now at least
+/// a circular cylinder's of the waist's radius: both are whole bands.
+#[test]
+fn a_sharp_waist_meshed_from_beside_it_is_a_whole_band() {
+    for c in [30.0_f64, 100.0] {
+        let field =
+            LieField::<f64>::new(&Invariant::from_numbers(&[1.0, 1.0, -c, 0.0, 0.0, 0.0]).unwrap());
+        let z = 0.3 / c.sqrt();
+        let r = (1.0 + c * z * z).sqrt();
+        let run = liemesh::run(&field, &MeshParams::at([0.8 * r, 0.6 * r, z])).unwrap();
+        let v = &run.validation;
+        assert!(v.is_valid(), "c {c}: {v}");
+        assert_eq!(
+            (v.euler_characteristic, v.boundary_loops, run.stitched.holes),
+            (0, 2, 0),
+            "c {c}: {v}"
+        );
+        assert!(run.params.dt_max >= 0.5, "c {c}: {:?}", run.params);
+    }
+}
+
 /// A 25:1 oblate ellipsoid (`λ` = 1, 1, 625, flatter than the automatic clamps are fitted
 /// to) from generic points, with defaults: the rim bends more sharply (radius 0.0016) than
 /// the automatic `dt_min` (about 0.025) can follow. The curves stopped there "at a singular
