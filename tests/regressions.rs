@@ -544,10 +544,10 @@ fn a_flared_hyperboloid_from_its_flange_is_never_closed_off_across_its_waist() {
 
 /// `[1, 1, −c]` from beside its waist, `(0.8 r, 0.6 r, 0.3 / √c)`, with defaults: the step
 /// scale there follows the waist's bend along the axis (radius `1/c`), so the automatic
-/// `dt_max` was a tenth of the waist's radius and more, and the curves round the girth,
-/// many times the band needs, met across the bend and left a hole (c = 30: 38,875
+/// `dt_max` was 0.12–0.16 of the waist's radius, and the curves went round the girth in
+/// steps that short and left a slit where their fronts met across the bend (c = 30: 38,875
 /// triangles, χ = −1; c = 100: 32,195, χ = −1). Round a hole the largest step is now at least
-/// a circular cylinder's of the waist's radius: both are whole bands.
+/// what a circular cylinder of the waist's radius gets: both are whole bands.
 #[test]
 fn a_sharp_waist_meshed_from_beside_it_is_a_whole_band() {
     for c in [30.0_f64, 100.0] {
