@@ -85,8 +85,8 @@ pub trait NormalField<T: Scalar>: Sync {
         self.semi_axes_through(p0).is_some()
     }
 
-    /// The hole the surface through `p0` goes round, when the field knows it: a one-sheet
-    /// hyperboloid's or an elliptic cylinder's waist, a torus's ring ([`Hole`]). The mesh
+    /// The hole the surface through `p0` goes round, when the field knows it is a band: a
+    /// one-sheet hyperboloid's or an elliptic cylinder's waist ([`Hole`]). The mesh
     /// then keeps every triangle off the hole's axis (the stitching, the flips and the last
     /// check of a run, [`crate::run`]), a boundary loop that does not go round the axis is
     /// reported as a hole ([`crate::triangulate::Stitched::holes`]), and no automatic step is
@@ -139,8 +139,12 @@ impl<T: Scalar, F: NormalField<T> + ?Sized> NormalField<T> for &F {
     }
 }
 
-/// The hole a surface goes round (a band's waist, a torus's ring), as a field knows it
-/// ([`NormalField::hole_through`]).
+/// The hole a band goes round (a one-sheet hyperboloid's or a cylinder's waist), as a field
+/// knows it ([`NormalField::hole_through`]).
+///
+/// The mesher takes every loop on the surface that does not go round the axis to bound a
+/// disc of it, which holds for a band but not for a torus (a loop round its tube does not go
+/// round its axis either): declare holes of bands only.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Hole {
     axis: [[f64; 3]; 2],
@@ -155,7 +159,7 @@ impl Hole {
     ///
     /// ```
     /// use liemesh::model::Hole;
-    /// // A torus about the z axis, ring radius 2, tube radius 0.5.
+    /// // The hyperboloid x² + y² − 4z² = 2.25 about the z axis: its waist has radius 1.5.
     /// let hole = Hole::new([[0.0; 3], [0.0, 0.0, 1.0]], 1.5).unwrap();
     /// assert_eq!(hole.waist(), 1.5);
     /// assert!(Hole::new([[0.0; 3], [0.0; 3]], 1.5).is_none());
