@@ -294,7 +294,7 @@ pub fn run_observed<T: Scalar, F: NormalField<T>>(
     observe(Progress::at(Stage::Triangulating, points, curves, 0));
     let improve = params.mode == Mode::Default;
     // The axis of the hole the field knows, which no face may meet.
-    let axis = field.hole_through(params.p0).map(|h| h.axis());
+    let axis = params.hole.map(|h| h.axis());
     // A mesh that is stitched is flipped to surface Delaunay once it is whole, not as a chart.
     let (mut mesh, chart) =
         triangulate::triangulate(&samples, params.close, improve && !params.close)?;

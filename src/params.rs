@@ -8,7 +8,7 @@
 
 use crate::error::MeshError;
 use crate::geom::vec3::dot as dot3;
-use crate::model::{least_aligned_tangent, LocalShape, NormalField};
+use crate::model::{least_aligned_tangent, Hole, LocalShape, NormalField};
 use crate::scalar::Scalar;
 
 /// An angle. Kept in radians; read and written in degrees wherever a person sees it (files,
@@ -318,6 +318,11 @@ pub struct Resolved {
     /// that is not known to be the gradient of a cubic
     /// ([`NormalField::has_cubic_potential`](crate::NormalField::has_cubic_potential)).
     pub level_correction: bool,
+    /// The hole of the band through `p0`, if the field knows it
+    /// ([`NormalField::hole_through`]): no triangle of the run meets its axis. Asked of the
+    /// field once, here (not in the serialised form).
+    #[cfg_attr(feature = "serde", serde(skip))]
+    pub hole: Option<Hole>,
 }
 
 impl Resolved {
@@ -441,7 +446,8 @@ impl MeshParams {
         // waist's bend as well took the curves through a 100:1 waist, where the fronts then
         // met and left the flange a disc with a wedge open, instead of a band round the
         // waist cut short there: docs/status.md.)
-        let waist = field.hole_through(self.p0).map(|h| h.waist());
+        let hole = field.hole_through(self.p0);
+        let waist = hole.map(|h| h.waist());
         let (thickness, sharpest) = field
             .semi_axes_through(self.p0)
             .filter(|[s0, _, s2]| *s2 <= FITTED_FLATNESS * *s0)
@@ -502,6 +508,7 @@ impl MeshParams {
             max_radius,
             bounding_box: self.bounding_box.unwrap_or(AUTO_BOX * scales.extent),
             level_correction: integrable && !field.has_cubic_potential(),
+            hole,
         };
         resolved.check_lengths()?;
         Ok(resolved)

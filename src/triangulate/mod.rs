@@ -299,7 +299,7 @@ pub(crate) fn stitch<T: Scalar, F: NormalField<T>>(
 ) -> Stitched {
     // Chart triangles across the surface's hole (a band's waist seen from a flat flange, where
     // the chart is a disc) go first; the stitching then holds its own to the same line.
-    let axis = field.hole_through(params.p0).map(|h| h.axis());
+    let axis = params.hole.map(|h| h.axis());
     let across = drop_across(mesh, axis);
     let mut stitched = stitch_chart(field, params, samples, mesh, vertices, axis);
     stitched.removed += across;

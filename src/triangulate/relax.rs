@@ -115,7 +115,7 @@ pub(crate) fn relax<T: Scalar, F: NormalField<T>>(
         &mut mesh.triangles,
         budget,
         pinned,
-        field.hole_through(params.p0).map(|h| h.axis()),
+        params.hole.map(|h| h.axis()),
     );
     *vertices = pos;
 }
