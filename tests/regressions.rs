@@ -516,6 +516,51 @@ fn a_flared_hyperboloid_stopped_at_its_waist_says_it_was_cut_short() {
     assert!(!cone.is_regular_through([0.6, 0.8, 1.0]));
 }
 
+/// A field of one's own knows nothing of its surface's singular points. The hyperboloid
+/// `x² + y² − 30 z² = 1` written as a closure, meshed with defaults from its flange
+/// (`f = 2` below), came out as a 735-triangle disc over the flange: a curve that could not
+/// follow the waist's bend at `dt_min` ended "at a singular point" and nothing said the run was
+/// cut short. The field's zero nearest that bend is the centre, off the surface: the curve now
+/// ends on the step floor, and the run says so. The same closure's cone, and its elliptic
+/// cone up to 4:1, still end at their apex as at a singular point; a 10:1 elliptic cone's
+/// curves stopped at its sharp sides, far from the apex, were cut short too (with a quarter
+/// of the `dt_min` they go on).
+#[test]
+fn a_closure_stopped_at_a_sharp_bend_says_it_was_cut_short() {
+    use liemesh::model::FnField;
+    use liemesh::scalar::Dual;
+    let quadric = |a: f64, b: f64, c: f64| {
+        FnField::new(move |p: &Vec3<Dual<f64>>| {
+            Vec3::new(
+                p.x.clone() * Dual::constant(a),
+                p.y.clone() * Dual::constant(b),
+                p.z.clone() * Dual::constant(c),
+            )
+        })
+    };
+    let (c, f) = (30.0_f64, 2.0_f64);
+    let z = f / c.sqrt();
+    let r = (1.0 + c * z * z).sqrt();
+    let run = liemesh::run(
+        &quadric(1.0, 1.0, -c),
+        &MeshParams::at([0.8 * r, 0.6 * r, z]),
+    )
+    .unwrap();
+    let ends = run.samples.ends();
+    assert!(run.validation.is_valid(), "{}", run.validation);
+    assert_eq!(ends.singular, 0, "{ends:?}");
+    assert!(ends.budget > 0, "{ends:?}");
+    assert!(run.cut_short().join("; ").contains("smaller dt_min"));
+    for (b, apex_only) in [(1.0_f64, true), (16.0, true), (100.0, false)] {
+        let p0 = [0.6, 0.8 / b.sqrt(), 1.0];
+        let run = liemesh::run(&quadric(1.0, b, -1.0), &MeshParams::at(p0)).unwrap();
+        let ends = run.samples.ends();
+        assert!(run.validation.is_valid(), "1:{b}: {}", run.validation);
+        assert!(ends.singular > 0, "1:{b}: {ends:?}");
+        assert_eq!(ends.budget == 0, apex_only, "1:{b}: {ends:?}");
+    }
+}
+
 /// `[1, 1, −c]` (waist radius 1) with defaults from `(0.8 r, 0.6 r, f / √c)` on its flange:
 /// at c = 100, f = 5 the steps, sized at the nearly flat `p0`, went round the waist in a
 /// hexagon and the run came out as a 150-triangle disc with a triangle across the waist and

@@ -80,7 +80,10 @@ pub trait NormalField<T: Scalar>: Sync {
     /// at `dt_min` (the waist of a sharply flared hyperboloid, the rim of a flat ellipsoid)
     /// ends on the step floor, which the run reports as cut short by a budget, not as at a
     /// singular point. The default says so for an ellipsoid the field knows
-    /// ([`Self::semi_axes_through`]) and otherwise `false`, which is always safe.
+    /// ([`Self::semi_axes_through`]) and otherwise `false`, which is always safe: a field
+    /// integrable at `p0` is then asked at each such bend whether it vanishes on the surface
+    /// near it (a zero of its linearisation on the level set, within a few dozen radii of the
+    /// bend), and only then is the end counted as at a singular point.
     fn is_regular_through(&self, p0: [f64; 3]) -> bool {
         self.semi_axes_through(p0).is_some()
     }

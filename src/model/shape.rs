@@ -100,6 +100,70 @@ pub fn least_aligned_tangent(n: [f64; 3]) -> [f64; 3] {
     t.map(|x| x / l)
 }
 
+/// How far a zero of the field may lie from a bend and still be blamed for it, in the bend's
+/// radii of curvature. A circular cone of half-angle `α` bends at distance `d` from its apex
+/// with radius `d tan α`, so this takes in cones down to a half-angle of about 2°; an
+/// elliptic cone's flat side bends more sharply than its apex accounts for, and a step floor
+/// met there ends its curve short of where it could have gone.
+const ZERO_REACH: f64 = 32.0;
+
+/// How far off the level set through the bend a zero of the field may lie and still be a
+/// singular point of the surface: the potential's change to it over `|v| |δ|` (`δ` the step to
+/// the zero). On a cone it is zero to rounding; a one-sheet hyperboloid's field `A p`
+/// vanishes at the centre, where the ratio is `c / (2 |A p| |p|)` (0.2–0.5 near its waist).
+const ON_LEVEL: f64 = 0.01;
+
+/// Whether a bend of the surface at `p` of radius `radius` too sharp for the smallest step can
+/// be blamed on a singular point: a zero of the field on the level set through `p`, within
+/// [`ZERO_REACH`] radii. For a field integrable at `p` only.
+///
+/// The field's linearisation at `p` gives the nearest zero (a least-squares Newton step, which
+/// also finds a zero set that is a curve), and Simpson's rule for `∫ v · dp` on the way there
+/// (exact on a cubic potential) says whether it is on the level set. `false` means the field
+/// is regular there and the bend only sharp — a flared one-sheet hyperboloid's waist, whose
+/// field vanishes only at the centre, off the surface — so that a curve stopped there was cut
+/// short. Where the linearisation has no zero (a field scaled to unit length) nothing is
+/// known, and the answer is `true`, as it was before a field could be asked.
+pub(crate) fn bend_has_singular_point<T: Scalar, F: NormalField<T> + ?Sized>(
+    field: &F,
+    p: [f64; 3],
+    radius: f64,
+) -> bool {
+    let at = |x: [f64; 3]| field.normal(&Vec3::<T>::from_f64(x)).to_f64();
+    let v = at(p);
+    let j = super::jacobian(field, &Vec3::<T>::from_f64(p)).map(|row| row.to_f64());
+    let finite = |a: [f64; 3]| a.iter().all(|x| x.is_finite());
+    if !(finite(v) && j.iter().all(|r| finite(*r)) && radius.is_finite()) {
+        return true;
+    }
+    let jm = nalgebra::Matrix3::from_fn(|r, c| j[r][c]);
+    let vm = nalgebra::Vector3::from(v);
+    let svd = jm.svd(true, true);
+    let tolerance = 1e-12 * svd.singular_values.max();
+    let Ok(step) = svd.solve(&(-vm), tolerance) else {
+        return true;
+    };
+    // A zero of the linearisation, or none (a unit field's Jacobian is blind along it).
+    if (vm + jm * step).norm() > 0.5 * vm.norm() {
+        return true;
+    }
+    let delta: [f64; 3] = step.into();
+    let reach = norm(delta);
+    if reach > ZERO_REACH * radius {
+        return false;
+    }
+    let mid = [0, 1, 2].map(|k| p[k] + 0.5 * delta[k]);
+    let zero = [0, 1, 2].map(|k| p[k] + delta[k]);
+    let (vm_, vz) = (at(mid), at(zero));
+    let change = [0, 1, 2]
+        .map(|k| (v[k] + 4.0 * vm_[k] + vz[k]) * delta[k])
+        .iter()
+        .sum::<f64>()
+        / 6.0;
+    // (A change that is not a number says nothing either.)
+    change.abs() <= ON_LEVEL * norm(v) * reach || change.is_nan()
+}
+
 fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
     a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 }
@@ -165,6 +229,59 @@ mod tests {
         assert!(symmetric.expect("regular").integrability_defect < 1e-15);
         let literal = LocalShape::at::<f64, _>(&field(&[1.0, 4.0, 9.0, 0.3, 0.5, 0.7]), p);
         assert!(literal.expect("regular").integrability_defect > 1e-3);
+    }
+
+    #[test]
+    fn a_sharp_bend_is_blamed_on_a_cone_apex_but_not_on_a_hyperboloid_centre() {
+        // Near a cone's apex the bend's radius is about the distance to it.
+        let cone = field(&[1.0, 1.0, -1.0, 0.0, 0.0, 0.0]);
+        assert!(bend_has_singular_point::<f64, _>(
+            &cone,
+            [6e-4, 8e-4, 1e-3],
+            1e-3
+        ));
+        // ... but a bend 100 times sharper than the apex explains is not its doing.
+        assert!(!bend_has_singular_point::<f64, _>(
+            &cone,
+            [6e-4, 8e-4, 1e-3],
+            1e-5
+        ));
+        // A flared waist bends with radius 1/100; its field vanishes only at the centre, too
+        // far from the waist, and off the surface even for a bend of radius 1.
+        let flared = field(&[1.0, 1.0, -100.0, 0.0, 0.0, 0.0]);
+        let waist = [1.02, 0.0, 0.0404f64.sqrt() / 10.0];
+        assert!(!bend_has_singular_point::<f64, _>(&flared, waist, 0.01));
+        assert!(!bend_has_singular_point::<f64, _>(&flared, waist, 1.0));
+        // A field scaled to unit length has no zero to find: nothing is known.
+        struct Unit;
+        impl<T: Scalar> NormalField<T> for Unit {
+            fn normal(&self, p: &Vec3<T>) -> Vec3<T> {
+                let n = p.norm_squared().sqrt();
+                Vec3::new(
+                    p.x.clone() / n.clone(),
+                    p.y.clone() / n.clone(),
+                    p.z.clone() / n,
+                )
+            }
+            fn normal_and_jvp(&self, p: &Vec3<T>, w: &Vec3<T>) -> (Vec3<T>, Vec3<T>) {
+                let n = p.norm_squared().sqrt();
+                let u = self.normal(p);
+                let along = u.x.clone() * w.x.clone()
+                    + u.y.clone() * w.y.clone()
+                    + u.z.clone() * w.z.clone();
+                let j = Vec3::new(
+                    (w.x.clone() - u.x.clone() * along.clone()) / n.clone(),
+                    (w.y.clone() - u.y.clone() * along.clone()) / n.clone(),
+                    (w.z.clone() - u.z.clone() * along) / n,
+                );
+                (u, j)
+            }
+        }
+        assert!(bend_has_singular_point::<f64, _>(
+            &Unit,
+            [0.0, 0.0, 1.0],
+            1e-3
+        ));
     }
 
     #[test]

@@ -13,7 +13,7 @@ mod grid;
 use crate::error::MeshError;
 use crate::geom::vec3::{dist, dot, sub};
 use crate::mesh::Provenance;
-use crate::model::LocalShape;
+use crate::model::{bend_has_singular_point, LocalShape};
 use crate::params::{MeshParams, Method, Mode, Resolved};
 use crate::progress::{Progress, Stage, SAMPLING_REPORT_EVERY};
 use crate::scalar::{Scalar, Vec3};
@@ -36,13 +36,16 @@ pub enum CurveEnd {
     Collision,
     /// Came too close to a neighbouring curve (proposed method).
     Merge,
-    /// Met a singular point (vanishing normal, no tangent direction, non-finite value).
+    /// Met a singular point (vanishing normal, no tangent direction, non-finite value), or
+    /// the step floor `dt_min` where the surface may have one (a cone's apex).
     Singular,
     /// A budget ran out: points, steps per curve, Newton's iterations for a chord at every
     /// length tried ([`StepStop::NoChord`](crate::trace::StepStop::NoChord)), or the step
-    /// floor `dt_min` on a surface known to have no singular point
+    /// floor `dt_min` at a bend with no singular point: on a surface known to have none
     /// ([`NormalField::is_regular_through`]: an ellipsoid's rim or a flared hyperboloid's
-    /// waist bending more sharply than that step can follow).
+    /// waist bending more sharply than that step can follow), or, on a field integrable at
+    /// `p0`, where the nearest zero of the field is off the surface or too far to account for
+    /// the bend (the same waist written as a closure, an elliptic cone's sharp sides).
     Budget,
 }
 
@@ -322,6 +325,7 @@ pub(crate) fn sample_resolved<T: Scalar, F: NormalField<T>>(
         },
         pos: vec![params.p0],
         no_singular_point: field.is_regular_through(params.p0),
+        level_set: LocalShape::at::<T, F>(field, params.p0).is_some_and(|s| s.is_integrable()),
         nrm: vec![n0.to_f64()],
         chart: vec![[0.0, 0.0]],
         live: Vec::new(),
@@ -402,6 +406,10 @@ struct Sampler<'a, T, F> {
     /// ([`NormalField::is_regular_through`]): a step that cannot follow the bend at `dt_min`
     /// then ends its curve on the step floor ([`CurveEnd::Budget`]), not at a singular point.
     no_singular_point: bool,
+    /// Whether the field is integrable at `p0`: the surface is a level set, and a bend the
+    /// step floor cannot follow is asked whether a singular point of it is near
+    /// ([`bend_has_singular_point`]).
+    level_set: bool,
 }
 
 impl<T: Scalar, F: NormalField<T>> Sampler<'_, T, F> {
@@ -476,16 +484,24 @@ impl<T: Scalar, F: NormalField<T>> Sampler<'_, T, F> {
         let len = step.dt.to_f64();
         let q = step.point.to_f64();
         // A step clamped at the smallest length that still turns the normal by more than
-        // twice the band's top is at a singular point (a cone's apex): the field's curvature
-        // grows without bound there, and the next step would jump across it. On a surface
-        // known to have none, it is a bend sharper than `dt_min` resolves (the rim of an
-        // ellipsoid flatter than the fitted clamps, a sharply flared hyperboloid's waist): the
-        // step floor ended the curve, and the run says so.
+        // twice the band's top may be at a singular point (a cone's apex): the field's
+        // curvature grows without bound there, and the next step would jump across it. On a
+        // surface known to have none, or at a bend no zero of the field on the surface
+        // accounts for, it is a bend sharper than `dt_min` resolves (the rim of an ellipsoid
+        // flatter than the fitted clamps, a sharply flared hyperboloid's waist, an elliptic
+        // cone's sharp side): the step floor ended the curve, and the run says so.
         if step.limit == StepLimit::Clamped
             && len <= self.params.dt_min * (1.0 + 1e-9)
             && step.alpha_predicted > SINGULAR_TURN * self.params.beta_max.radians()
         {
-            return Some(if self.no_singular_point {
+            let regular = self.no_singular_point
+                || (self.level_set
+                    && !bend_has_singular_point(
+                        self.field,
+                        live.p.to_f64(),
+                        len / step.alpha_predicted,
+                    ));
+            return Some(if regular {
                 CurveEnd::Budget
             } else {
                 CurveEnd::Singular
