@@ -318,6 +318,13 @@ pub struct Resolved {
     /// that is not known to be the gradient of a cubic
     /// ([`NormalField::has_cubic_potential`](crate::NormalField::has_cubic_potential)).
     pub level_correction: bool,
+    /// Whether that correction weighs the field by an integrating factor: a field integrable
+    /// at `p0` that is not a gradient (it has a curl near `p0`), such as unit normals of a
+    /// surface. Only a gradient's rise along a chord is the potential's; on `v = g ∇F` it is
+    /// weighed by `1/g`, whose change along the surface the field's curl gives
+    /// ([`crate::trace`]). Not in the serialised form.
+    #[cfg_attr(feature = "serde", serde(skip))]
+    pub integrating_factor: bool,
     /// The hole of the band through `p0`, if the field knows it
     /// ([`NormalField::hole_through`]): no triangle of the run meets its axis. Asked of the
     /// field once, here (not in the serialised form).
@@ -394,6 +401,32 @@ const STEPS_ACROSS_RADIUS: f64 = 12.0;
 /// Centres of curvature up to this many extents (of the shape at `p0`) from the origin raise
 /// the extent ([`Scales::centres_reach`]).
 const CENTRE_REACH: f64 = 16.0;
+
+/// A curl below this, relative to the Jacobian's size, is a gradient's rounding.
+const CURL_FREE: f64 = 1e-10;
+
+/// Whether the field has a curl at `p0` or a step's scale from it along any axis (seven
+/// Jacobians): a gradient has none anywhere, while unit normals of a surface `F = 0`, say,
+/// may have none at a point of symmetry (an ellipsoid's vertex) but do beside it.
+fn has_curl_near<T: Scalar, F: NormalField<T> + ?Sized>(
+    field: &F,
+    p0: [f64; 3],
+    step: f64,
+) -> bool {
+    let offsets = [[0.0; 3], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+    offsets
+        .iter()
+        .flat_map(|o| [1.0, -1.0].map(|sign| [0, 1, 2].map(|k| p0[k] + sign * 0.5 * step * o[k])))
+        .skip(1)
+        .any(|x| {
+            let j = crate::model::jacobian(field, &crate::scalar::Vec3::<T>::from_f64(x))
+                .map(|row| row.to_f64());
+            let curl = [j[2][1] - j[1][2], j[0][2] - j[2][0], j[1][0] - j[0][1]];
+            let size = j.iter().flatten().map(|x| x * x).sum::<f64>().sqrt();
+            let curl = curl.iter().map(|x| x * x).sum::<f64>().sqrt();
+            curl.is_finite() && size.is_finite() && curl > CURL_FREE * size
+        })
+}
 
 impl MeshParams {
     /// The defaults, from `p0`.
@@ -508,6 +541,9 @@ impl MeshParams {
             max_radius,
             bounding_box: self.bounding_box.unwrap_or(AUTO_BOX * scales.extent),
             level_correction: integrable && !field.has_cubic_potential(),
+            integrating_factor: integrable
+                && !field.has_cubic_potential()
+                && has_curl_near(field, self.p0, scales.step),
             hole,
         };
         resolved.check_lengths()?;

@@ -561,6 +561,43 @@ fn a_closure_stopped_at_a_sharp_bend_says_it_was_cut_short() {
     }
 }
 
+/// Unit normals are how many write a surface's field, and they are not a gradient: the
+/// ellipsoid `x² + 4 y² + 16 z² = 1` given by `∇F / |∇F|` was meshed with vertices up to
+/// 2.3·10⁻⁴–1.0·10⁻³ off it (its raw gradient: 10⁻¹⁵), because a chord's level correction
+/// took `∫ v·dp` for the potential's rise. It is now weighed by the integrating factor the
+/// field's curl gives (`Resolved::integrating_factor`): 0.9–3·10⁻⁶.
+#[test]
+fn unit_normals_of_ones_own_stay_on_their_surface() {
+    use liemesh::model::FnField;
+    use liemesh::scalar::{Dual, Scalar};
+    let level = |p: [f64; 3]| p[0] * p[0] + 4.0 * p[1] * p[1] + 16.0 * p[2] * p[2];
+    let unit = FnField::new(|p: &Vec3<Dual<f64>>| {
+        let k = |x: f64| Dual::constant(x);
+        let g = Vec3::new(p.x.clone(), k(4.0) * p.y.clone(), k(16.0) * p.z.clone());
+        let len =
+            (g.x.clone() * g.x.clone() + g.y.clone() * g.y.clone() + g.z.clone() * g.z.clone())
+                .sqrt();
+        Vec3::new(g.x / len.clone(), g.y / len.clone(), g.z / len)
+    });
+    for p0 in [[1.0, 0.0, 0.0], [0.6, 0.3, 0.1], [0.1, 0.1, 0.24]] {
+        let p0 = p0.map(|x| x / level(p0).sqrt());
+        let run = liemesh::run(&unit, &MeshParams::at(p0)).unwrap();
+        let v = &run.validation;
+        assert!(v.is_closed() && v.euler_characteristic == 2, "{p0:?}: {v}");
+        assert!(run.params.integrating_factor, "{p0:?}");
+        let off = run
+            .mesh
+            .vertices
+            .iter()
+            .map(|&q| {
+                let g = [q[0], 4.0 * q[1], 16.0 * q[2]];
+                (level(q) - 1.0).abs() / (2.0 * (g[0] * g[0] + g[1] * g[1] + g[2] * g[2]).sqrt())
+            })
+            .fold(0.0, f64::max);
+        assert!(off < 2e-5, "{p0:?}: a vertex {off:e} off the ellipsoid");
+    }
+}
+
 /// `[1, 1, −c]` (waist radius 1) with defaults from `(0.8 r, 0.6 r, f / √c)` on its flange:
 /// at c = 100, f = 5 the steps, sized at the nearly flat `p0`, went round the waist in a
 /// hexagon and the run came out as a 150-triangle disc with a triangle across the waist and

@@ -31,6 +31,9 @@ pub struct StepConfig<T> {
     overshoot_cos: f64,
     /// Whether chords are corrected back onto their level set ([`Resolved::level_correction`]).
     level_correction: bool,
+    /// Whether that correction weighs the field by an integrating factor
+    /// ([`Resolved::integrating_factor`]).
+    integrating_factor: bool,
 }
 
 impl<T: Scalar> StepConfig<T> {
@@ -49,6 +52,7 @@ impl<T: Scalar> StepConfig<T> {
             max_retries: params.max_retries,
             // Only the default mode's chords read it.
             level_correction: params.level_correction,
+            integrating_factor: params.integrating_factor,
             overshoot_cos: {
                 let angle = OVERSHOOT * params.beta_max.radians();
                 if angle < std::f64::consts::PI {
@@ -63,6 +67,12 @@ impl<T: Scalar> StepConfig<T> {
     /// The step mode.
     pub fn mode(&self) -> Mode {
         self.mode
+    }
+
+    /// Whether the level correction weighs the field by an integrating factor
+    /// ([`Resolved::integrating_factor`]).
+    pub(crate) fn integrating_factor(&self) -> bool {
+        self.integrating_factor
     }
 }
 
@@ -330,7 +340,7 @@ pub fn step<T: Scalar, F: NormalField<T>>(
                 .scale(&(cw.clone() + cw))
                 .add_scaled(&-T::one(), &w);
             let point = if cfg.level_correction {
-                on_level(field, p, &v, &chord, &dt)
+                on_level(field, cfg, p, &v, &chord, &dt)
             } else {
                 chord.point
             };
@@ -383,7 +393,7 @@ pub fn step_fixed<T: Scalar, F: NormalField<T>>(
             };
             let chord = drift_free_chord(field, cfg, &start, length, &kappa)?;
             if chord.converged && cfg.level_correction {
-                Ok(on_level(field, p, &v, &chord, length))
+                Ok(on_level(field, cfg, p, &v, &chord, length))
             } else if chord.converged {
                 Ok(chord.point)
             } else {
@@ -401,11 +411,21 @@ pub fn step_fixed<T: Scalar, F: NormalField<T>>(
 /// missed, the potential `F(q) − F(p)`, which divided by `|v(q)|` is a distance. Both rules
 /// are exact where the potential is a cubic (every integrable field of the model): then the
 /// estimate is rounding. Four field values, in `f64`.
+///
+/// With `weighted` ([`StepConfig::integrating_factor`]) the field is weighed by its
+/// integrating factor along the segment first ([`Weighed`]).
 pub(crate) fn chord_drift<T: Scalar, F: NormalField<T>>(
     field: &F,
     p: &Vec3<T>,
     q: &Vec3<T>,
+    weighted: bool,
 ) -> f64 {
+    if weighted {
+        let d = q - p;
+        let w = Weighed::along(field, p, &d);
+        let speed = w.values[4].norm_squared().sqrt().to_f64() * w.factors[4].to_f64();
+        return ((w.boole() - w.simpson()).to_f64() / speed).abs();
+    }
     let (a, b) = (p.to_f64(), q.to_f64());
     let d = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
     let along = |t: f64| -> f64 {
@@ -430,13 +450,32 @@ pub(crate) fn chord_drift<T: Scalar, F: NormalField<T>>(
 /// so what it gives is what the chord left of the rise (Simpson's truncation error is of the
 /// fifth order in the length, Boole's of the seventh). The end moves against it along `v(q)`:
 /// `q − (ΔF / |v(q)|²) v(q)`. (A superellipsoid's curves drifted 7.3e-4 of its size so.)
+///
+/// On a field that is not a gradient but has one as a multiple, `v = g ∇F` (unit normals),
+/// `∫ v·dp` is not the rise of any potential; with `cfg`'s integrating factor on, the rise is
+/// that of `∫ v·dp / g` ([`Weighed`]) and the end moves by it over `|v(q)|² / g(q)`.
 fn on_level<T: Scalar, F: NormalField<T>>(
     field: &F,
+    cfg: &StepConfig<T>,
     p: &Vec3<T>,
     v0: &Vec3<T>,
     chord: &Chord<T>,
     length: &T,
 ) -> Vec3<T> {
+    if cfg.integrating_factor {
+        let d = chord.direction.scale(length);
+        let w = Weighed::along(field, p, &d);
+        let end = &w.values[4];
+        let moved = chord.point.add_scaled(
+            &(-(w.boole() / (end.norm_squared() * w.factors[4].clone()))),
+            end,
+        );
+        return if moved.is_finite() {
+            moved
+        } else {
+            chord.point.clone()
+        };
+    }
     let c = &chord.direction;
     let along = |t: f64| {
         field
@@ -456,6 +495,88 @@ fn on_level<T: Scalar, F: NormalField<T>>(
         moved
     } else {
         chord.point.clone()
+    }
+}
+
+/// The field along the segment `p + t d`, `t = 0, ¼, ½, ¾, 1`, with an integrating factor
+/// `μ = 1/g` for a field `v = g ∇F` that is not a gradient, so that `μ v` is one and
+/// `∫ μ v·dp` the rise of its potential (Boole's and Simpson's rules on `μ v·d`).
+///
+/// The factor's change along the surface is the field's own: `curl(μ v) = 0` gives
+/// `∇ln μ × v = −curl v`, whose solution across `v` is `a = (curl v × v) / |v|²` (along `v`
+/// it is free: another factor relabels the level sets). `ln μ` is `a·d` integrated from `p`
+/// on the quadratic through its values at `t = 0, ½, 1` (three Jacobians, from which the
+/// curl comes), and `μ(p) = 1`.
+struct Weighed<T> {
+    /// `v` at the five points.
+    values: [Vec3<T>; 5],
+    /// `μ` at the five points.
+    factors: [T; 5],
+    /// `μ v·d` at the five points.
+    rates: [T; 5],
+}
+
+impl<T: Scalar> Weighed<T> {
+    fn along<F: NormalField<T>>(field: &F, p: &Vec3<T>, d: &Vec3<T>) -> Self {
+        let at = |t: f64| p.add_scaled(&T::from_f64(t), d);
+        // v and a·d at a point, from its Jacobian.
+        let with_rate = |x: &Vec3<T>| {
+            let e = |k: usize| {
+                let mut u = Vec3::zero();
+                match k {
+                    0 => u.x = T::one(),
+                    1 => u.y = T::one(),
+                    _ => u.z = T::one(),
+                }
+                field.normal_and_jvp(x, &u)
+            };
+            let ((v, cx), (_, cy), (_, cz)) = (e(0), e(1), e(2));
+            // Columns ∂v/∂x, ∂v/∂y, ∂v/∂z; curl = (∂y vz − ∂z vy, ∂z vx − ∂x vz, ∂x vy − ∂y vx).
+            let curl = Vec3::new(
+                cy.z.clone() - cz.y.clone(),
+                cz.x.clone() - cx.z.clone(),
+                cx.y.clone() - cy.x.clone(),
+            );
+            let rate = curl.cross(&v).dot(d) / v.norm_squared();
+            (v, rate)
+        };
+        let (v0, a0) = with_rate(p);
+        let (v2, a2) = with_rate(&at(0.5));
+        let (v4, a4) = with_rate(&at(1.0));
+        let (v1, v3) = (field.normal(&at(0.25)), field.normal(&at(0.75)));
+        // ∫₀ᵗ of the quadratic through (0, a0), (½, a2), (1, a4).
+        let b = T::from_f64(4.0) * a2.clone() - T::from_f64(3.0) * a0.clone() - a4.clone();
+        let c = T::from_f64(2.0) * (a0.clone() + a4 - T::from_f64(2.0) * a2);
+        let log_factor = |t: f64| {
+            let t = T::from_f64(t);
+            let t2 = t.clone() * t.clone();
+            a0.clone() * t.clone()
+                + b.clone() * t2.clone() / T::from_f64(2.0)
+                + c.clone() * t2 * t / T::from_f64(3.0)
+        };
+        let factors = [0.0, 0.25, 0.5, 0.75, 1.0].map(|t| log_factor(t).exp());
+        let values = [v0, v1, v2, v3, v4];
+        let rates = [0, 1, 2, 3, 4].map(|k| factors[k].clone() * values[k].dot(d));
+        Weighed {
+            values,
+            factors,
+            rates,
+        }
+    }
+
+    /// Boole's rule for `∫ μ v·dp`.
+    fn boole(&self) -> T {
+        let f = &self.rates;
+        (T::from_f64(7.0) * (f[0].clone() + f[4].clone())
+            + T::from_f64(32.0) * (f[1].clone() + f[3].clone())
+            + T::from_f64(12.0) * f[2].clone())
+            / T::from_f64(90.0)
+    }
+
+    /// Simpson's rule for `∫ μ v·dp`.
+    fn simpson(&self) -> T {
+        let f = &self.rates;
+        (f[0].clone() + T::from_f64(4.0) * f[2].clone() + f[4].clone()) / T::from_f64(6.0)
     }
 }
 
@@ -790,6 +911,68 @@ mod tests {
         // Explicit Euler leaves the sphere by 1 + Δt²/2 to first order.
         let r = s.point.norm();
         assert!(r > 1.0 + 0.4 * s.dt * s.dt, "{r}");
+    }
+
+    /// Unit normals of the ellipsoid `x² + 4 y² + 16 z² = 1`: integrable, not a gradient.
+    struct UnitEllipsoid;
+    impl<T: Scalar> NormalField<T> for UnitEllipsoid {
+        fn normal(&self, p: &Vec3<T>) -> Vec3<T> {
+            self.normal_and_jvp(p, &Vec3::zero()).0
+        }
+        fn normal_and_jvp(&self, p: &Vec3<T>, w: &Vec3<T>) -> (Vec3<T>, Vec3<T>) {
+            let k = |x: f64| T::from_f64(x);
+            let g = Vec3::new(p.x.clone(), k(4.0) * p.y.clone(), k(16.0) * p.z.clone());
+            let dg = Vec3::new(w.x.clone(), k(4.0) * w.y.clone(), k(16.0) * w.z.clone());
+            let len = g.norm_squared().sqrt();
+            let n = g.scale(&(T::one() / len.clone()));
+            // d(g/|g|) = (dg − n (n·dg)) / |g|
+            let along = n.dot(&dg);
+            let jw = dg.add_scaled(&-along, &n).scale(&(T::one() / len));
+            (n, jw)
+        }
+    }
+
+    #[test]
+    fn unit_normals_are_weighed_back_onto_their_level_set() {
+        let field = UnitEllipsoid;
+        let level = |q: [f64; 3]| q[0] * q[0] + 4.0 * q[1] * q[1] + 16.0 * q[2] * q[2];
+        let p0 = [0.6f64, 0.3, 0.1].map(|x| x / level([0.6, 0.3, 0.1]).sqrt());
+        let params = crate::MeshParams::at(p0).resolve::<f64, _>(&field).unwrap();
+        assert!(params.level_correction && params.integrating_factor);
+        // How far a step of 0.1 along each axis ends off the ellipsoid (|F − 1| / |∇F|).
+        let off = |weighted: bool| {
+            let mut params = params.clone();
+            params.integrating_factor = weighted;
+            let cfg = StepConfig::<f64>::new(&params);
+            [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]
+                .map(|dir| {
+                    let q = step_fixed(
+                        &field,
+                        &cfg,
+                        &Vec3::from_f64(p0),
+                        &Vec3::from_f64(dir),
+                        &0.1,
+                    )
+                    .unwrap()
+                    .to_f64();
+                    let g = [q[0], 4.0 * q[1], 16.0 * q[2]];
+                    (level(q) - 1.0).abs()
+                        / (2.0 * (g[0] * g[0] + g[1] * g[1] + g[2] * g[2]).sqrt())
+                })
+                .into_iter()
+                .fold(0.0, f64::max)
+        };
+        let (plain, weighed) = (off(false), off(true));
+        assert!(
+            weighed < 3e-5 && weighed < plain / 10.0,
+            "{weighed:e} against {plain:e}"
+        );
+        // A gradient of one's own has no curl: its correction is the plain one.
+        let radial = crate::model::FnField::new(|p: &Vec3<crate::scalar::Dual<f64>>| p.clone());
+        let params = crate::MeshParams::at([1.0, 0.0, 0.0])
+            .resolve::<f64, _>(&radial)
+            .unwrap();
+        assert!(params.level_correction && !params.integrating_factor);
     }
 
     #[test]

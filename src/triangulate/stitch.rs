@@ -1397,7 +1397,12 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
             if taken + 2 * left <= MAX_HOPS
                 && self.growth.cfg.mode() == Mode::Default
                 && !self.growth.field.has_cubic_potential()
-                && trace::chord_drift(self.growth.field, &point, &next) > HOP_DRIFT * length
+                && trace::chord_drift(
+                    self.growth.field,
+                    &point,
+                    &next,
+                    self.growth.cfg.integrating_factor(),
+                ) > HOP_DRIFT * length
             {
                 left *= 2;
                 continue;
