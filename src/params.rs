@@ -402,10 +402,11 @@ const STEPS_ACROSS_RADIUS: f64 = 12.0;
 /// the extent ([`Scales::centres_reach`]).
 const CENTRE_REACH: f64 = 16.0;
 
-/// A curl below this, relative to the Jacobian's size, is a gradient's rounding.
+/// A curl below this, relative to the Jacobian's size, is a gradient's rounding (in `f64`;
+/// in a type of less precision, a thousand units of its roundoff).
 const CURL_FREE: f64 = 1e-10;
 
-/// Whether the field has a curl at `p0` or a step's scale from it along any axis (seven
+/// Whether the field has a curl at `p0` or half a step's scale from it along any axis (seven
 /// Jacobians): a gradient has none anywhere, while unit normals of a surface `F = 0`, say,
 /// may have none at a point of symmetry (an ellipsoid's vertex) but do beside it.
 fn has_curl_near<T: Scalar, F: NormalField<T> + ?Sized>(
@@ -413,19 +414,23 @@ fn has_curl_near<T: Scalar, F: NormalField<T> + ?Sized>(
     p0: [f64; 3],
     step: f64,
 ) -> bool {
-    let offsets = [[0.0; 3], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
-    offsets
-        .iter()
-        .flat_map(|o| [1.0, -1.0].map(|sign| [0, 1, 2].map(|k| p0[k] + sign * 0.5 * step * o[k])))
-        .skip(1)
-        .any(|x| {
-            let j = crate::model::jacobian(field, &crate::scalar::Vec3::<T>::from_f64(x))
-                .map(|row| row.to_f64());
-            let curl = [j[2][1] - j[1][2], j[0][2] - j[2][0], j[1][0] - j[0][1]];
-            let size = j.iter().flatten().map(|x| x * x).sum::<f64>().sqrt();
-            let curl = curl.iter().map(|x| x * x).sum::<f64>().sqrt();
-            curl.is_finite() && size.is_finite() && curl > CURL_FREE * size
-        })
+    let mut probes = vec![p0];
+    for k in 0..3 {
+        for offset in [0.5 * step, -0.5 * step] {
+            let mut x = p0;
+            x[k] += offset;
+            probes.push(x);
+        }
+    }
+    probes.into_iter().any(|x| {
+        let j = crate::model::jacobian(field, &crate::scalar::Vec3::<T>::from_f64(x))
+            .map(|row| row.to_f64());
+        let curl = [j[2][1] - j[1][2], j[0][2] - j[2][0], j[1][0] - j[0][1]];
+        let size = j.iter().flatten().map(|x| x * x).sum::<f64>().sqrt();
+        let curl = curl.iter().map(|x| x * x).sum::<f64>().sqrt();
+        let rounding = CURL_FREE.max(1e3 * T::unit_roundoff());
+        curl.is_finite() && size.is_finite() && curl > rounding * size
+    })
 }
 
 impl MeshParams {
