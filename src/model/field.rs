@@ -463,6 +463,14 @@ impl<T: Scalar, F: Fn(&Vec3<Dual<T>>) -> Vec3<Dual<T>> + Sync> NormalField<T> fo
 
 /// The full Jacobian `J_v(p)` (rows = components of `v`) by three JVPs.
 pub fn jacobian<T: Scalar, F: NormalField<T> + ?Sized>(field: &F, p: &Vec3<T>) -> Mat3<T> {
+    value_and_jacobian(field, p).1
+}
+
+/// `v(p)` and [`jacobian`], from the same three JVPs.
+pub(crate) fn value_and_jacobian<T: Scalar, F: NormalField<T> + ?Sized>(
+    field: &F,
+    p: &Vec3<T>,
+) -> (Vec3<T>, Mat3<T>) {
     let e = |i: usize| {
         let mut v = Vec3::zero();
         match i {
@@ -470,14 +478,15 @@ pub fn jacobian<T: Scalar, F: NormalField<T> + ?Sized>(field: &F, p: &Vec3<T>) -
             1 => v.y = T::one(),
             _ => v.z = T::one(),
         }
-        field.normal_and_jvp(p, &v).1
+        field.normal_and_jvp(p, &v)
     };
-    let (c0, c1, c2) = (e(0), e(1), e(2));
-    [
+    let ((v, c0), (_, c1), (_, c2)) = (e(0), e(1), e(2));
+    let j = [
         Vec3::new(c0.x.clone(), c1.x.clone(), c2.x.clone()),
         Vec3::new(c0.y.clone(), c1.y.clone(), c2.y.clone()),
         Vec3::new(c0.z, c1.z, c2.z),
-    ]
+    ];
+    (v, j)
 }
 
 #[cfg(test)]

@@ -13,6 +13,7 @@ mod formula;
 mod invariant;
 mod shape;
 
+pub(crate) use field::value_and_jacobian;
 pub use field::{jacobian, FnField, Hole, LieField, NormalField};
 pub use formula::{EveryScalar, FieldFormula, Formula};
 pub use invariant::{AngleReading, Invariant, InvariantError, InvariantKind, Lift, Mat3};

@@ -130,8 +130,8 @@ pub(crate) fn bend_has_singular_point<T: Scalar, F: NormalField<T> + ?Sized>(
     radius: f64,
 ) -> bool {
     let at = |x: [f64; 3]| field.normal(&Vec3::<T>::from_f64(x)).to_f64();
-    let v = at(p);
-    let j = super::jacobian(field, &Vec3::<T>::from_f64(p)).map(|row| row.to_f64());
+    let (v, j) = super::value_and_jacobian(field, &Vec3::<T>::from_f64(p));
+    let (v, j) = (v.to_f64(), j.map(|row| row.to_f64()));
     let finite = |a: [f64; 3]| a.iter().all(|x| x.is_finite());
     if !(finite(v) && j.iter().all(|r| finite(*r)) && radius.is_finite()) {
         return true;

@@ -519,23 +519,13 @@ struct Weighed<T> {
 impl<T: Scalar> Weighed<T> {
     fn along<F: NormalField<T>>(field: &F, p: &Vec3<T>, d: &Vec3<T>) -> Self {
         let at = |t: f64| p.add_scaled(&T::from_f64(t), d);
-        // v and a·d at a point, from its Jacobian.
+        // v and a·d at a point, from its Jacobian (rows ∇vx, ∇vy, ∇vz).
         let with_rate = |x: &Vec3<T>| {
-            let e = |k: usize| {
-                let mut u = Vec3::zero();
-                match k {
-                    0 => u.x = T::one(),
-                    1 => u.y = T::one(),
-                    _ => u.z = T::one(),
-                }
-                field.normal_and_jvp(x, &u)
-            };
-            let ((v, cx), (_, cy), (_, cz)) = (e(0), e(1), e(2));
-            // Columns ∂v/∂x, ∂v/∂y, ∂v/∂z; curl = (∂y vz − ∂z vy, ∂z vx − ∂x vz, ∂x vy − ∂y vx).
+            let (v, j) = crate::model::value_and_jacobian(field, x);
             let curl = Vec3::new(
-                cy.z.clone() - cz.y.clone(),
-                cz.x.clone() - cx.z.clone(),
-                cx.y.clone() - cy.x.clone(),
+                j[2].y.clone() - j[1].z.clone(),
+                j[0].z.clone() - j[2].x.clone(),
+                j[1].x.clone() - j[0].y.clone(),
             );
             let rate = curl.cross(&v).dot(d) / v.norm_squared();
             (v, rate)
