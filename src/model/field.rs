@@ -103,8 +103,9 @@ pub trait NormalField<T: Scalar>: Sync {
     /// Whether the field is exactly the gradient of a polynomial of degree at most three, as
     /// every integrable invariant's field is. The drift-free chord is exact on such a field
     /// (Simpson's rule integrates its quadratic `v·dp` exactly). On any other integrable field
-    /// each chord is corrected back onto its level set (its potential error estimated with
-    /// Boole's rule, removed by a step along the normal), at four more field values a step.
+    /// each chord is corrected back onto its level set (its potential error found with
+    /// Gauss–Legendre's five-point rule, removed by Newton steps along the normal), at six
+    /// more field values a step.
     /// The default, `false`, is always safe; `true` on a field that is not such a gradient
     /// leaves its chords' drift uncorrected.
     fn has_cubic_potential(&self) -> bool {
