@@ -50,7 +50,7 @@ pub enum Command {
     Recover(quality::RecoverArgs),
     /// Reproduce the paper: fig1..fig6 meshes and pictures, and Table 3 side by side.
     Paper(paper::PaperArgs),
-    /// Time the performance workloads (issue 6) and print a table or JSON.
+    /// Time the performance workloads, judge them against their targets and print a table or JSON.
     Bench(bench::BenchArgs),
     /// Mesh every invariant file of a folder (or list) in parallel: one mesh + report each.
     Batch(batch::BatchArgs),
