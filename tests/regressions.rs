@@ -598,29 +598,18 @@ fn unit_normals_of_ones_own_stay_on_their_surface() {
     }
 }
 
-/// A torus of one's own (`(ρ − 2)² + z² = 0.25` by its gradient, a `FnField`, defaults) was
+/// A torus of one's own (`(ρ − 2)² + z² = 0.25` by its gradient, [`RoundTorus`], defaults) was
 /// meshed with vertices up to 9.1·10⁻¹¹ off it: a chord's correction onto its level set
 /// estimated the potential's rise by Boole's rule, whose error is of the seventh order in the
 /// step. Gauss–Legendre's five-point rule, in the scalar's own precision, leaves 1.9·10⁻¹⁵.
 #[test]
 fn a_torus_of_ones_own_is_meshed_on_it_to_rounding() {
-    use liemesh::model::FnField;
-    use liemesh::scalar::{Dual, Scalar};
     let (big, a) = (2.0, 0.5);
-    // Half the gradient of (ρ − R)² + z².
-    let torus = FnField::new(move |p: &Vec3<Dual<f64>>| {
-        let rho = (p.x.clone() * p.x.clone() + p.y.clone() * p.y.clone()).sqrt();
-        let radial = (rho.clone() - Dual::constant(big)) / rho;
-        Vec3::new(
-            radial.clone() * p.x.clone(),
-            radial * p.y.clone(),
-            p.z.clone(),
-        )
-    });
+    let torus = liemesh::model::Formula(RoundTorus { big, small: a });
     for (u, v) in [(0.3_f64, 0.5_f64), (1.0, 2.5)] {
         let rho = big + a * v.cos();
         let p0 = [rho * u.cos(), rho * u.sin(), a * v.sin()];
-        let run = liemesh::run(&torus, &MeshParams::at(p0)).unwrap();
+        let run = liemesh::run::<f64, _>(&torus, &MeshParams::at(p0)).unwrap();
         let t = &run.validation;
         assert!(t.is_closed() && t.euler_characteristic == 0, "{p0:?}: {t}");
         // The distance from the tube's circle, less the tube's radius.
@@ -959,8 +948,8 @@ impl liemesh::model::FieldFormula for RoundTorus {
 /// most 1.4e-5: the two half chords that reach it turn fast there, and the potential is not a
 /// cubic, so Simpson's rule inside each chord drifts. A hop whose drift, estimated against
 /// Boole's rule, exceeds 1e-4 of its length is now taken again as two (4.7e-5), and every
-/// chord on a field whose potential is not a cubic is moved back onto its level set by
-/// that estimate (`trace::on_level`; with both, 1.6e-7).
+/// chord on a field whose potential is not a cubic is moved back onto its level set
+/// (`trace::on_level`; with both, 1.6e-7).
 #[test]
 fn a_new_point_of_the_front_on_a_fat_torus_stays_on_it() {
     let (big0, fat, scale, u, v) = (
