@@ -260,8 +260,8 @@ const FLAG_BITS: u32 = 3;
 /// every axis — where the lowest corner of their boxes' intersection lies — which the flags
 /// tell without reading the boxes. Sorting on the guest flag too puts a cell's own faces
 /// before its guests, so guest pairs (which meet at their own level) are never visited.
-pub(crate) struct PairGrid<'a> {
-    boxes: &'a [Aabb],
+pub(crate) struct PairGrid {
+    boxes: Vec<Aabb>,
     /// Entries sorted by key, faces ascending within a cell.
     filed: Vec<u64>,
     /// Start of each occupied cell's entries in `filed`, then the end.
@@ -272,10 +272,10 @@ pub(crate) struct PairGrid<'a> {
     guest_bit: u32,
 }
 
-impl<'a> PairGrid<'a> {
+impl PairGrid {
     /// Files `boxes` in levels of cells with base side `cell` (see [`cell_size`]). Boxes in
     /// a spatial order ([`spatial_order`]) make the pair loop read nearby memory.
-    pub fn new(boxes: &'a [Aabb], cell: f64) -> PairGrid<'a> {
+    pub fn new(boxes: Vec<Aabb>, cell: f64) -> PairGrid {
         let id_bits = 64 - (boxes.len() as u64).leading_zeros();
         let guest_bit = id_bits + FLAG_BITS;
         let tag_bits = guest_bit + 1;
@@ -798,7 +798,7 @@ mod tests {
         for (n, outliers) in [(0, 0), (1, 0), (50, 0), (400, 5), (400, 40), (400, 200)] {
             let boxes = random_boxes(&mut rng, n, outliers);
             for cell in [cell_size(&boxes), 1e-3, 0.3, 10.0, f64::NAN, 0.0] {
-                let grid = PairGrid::new(&boxes, cell);
+                let grid = PairGrid::new(boxes.clone(), cell);
                 let mut got = Vec::new();
                 grid.for_each_pair(|i, j| {
                     assert!(i < j);

@@ -171,6 +171,73 @@ pub(crate) fn planar_faces_intersect<O: Orient>(
     }
 }
 
+/// Whether a vertex's fan is certified embedded: every face at the vertex meets every other
+/// face at it only where they share corners, decided exactly without testing the pairs.
+///
+/// `rim` gives each face at the apex by its other two corners `(next, prev)`, in the face's
+/// own order (the face is `apex → next → prev`); `closed` says that the rim edges form one
+/// cycle (an interior vertex of a manifold, consistently oriented mesh), else one path (a
+/// boundary vertex). Projected along the axis `k` of the largest component of the first
+/// face's normal, the fan is certified when
+///
+/// * every face projects with the same non-zero orientation (exact `orient2d`): each face is
+///   then the graph of an affine function over its projection, and its projection lies in
+///   its sector, the wedge at the apex between its two edges (less than a half-turn);
+/// * the sectors turn once round the apex (closed) or less than once (open), so that they
+///   overlap only along the rays they share: the rim crosses the line through the apex
+///   parallel to the second projected coordinate axis upwards `U` and downwards `D` times
+///   (half-open comparisons, exact), a closed rim winds `U = D` times, and an open rim that
+///   turns a full turn or more crosses both ways, so `U = 1` (closed) or `U + D ≤ 1` (open)
+///   suffices.
+///
+/// Then two faces sharing only the apex project into sectors that meet only at the apex, so
+/// they meet only on the line through the apex along `k`, where each holds the apex alone;
+/// and two faces sharing an edge (orientations consistent: the caller's `closed` or path
+/// guarantees it) project to opposite sides of its projection, so they meet only on it, where
+/// each holds the edge alone. A `false` proves nothing: the caller tests those pairs.
+/// Non-finite corners answer `false`.
+pub(crate) fn fan_is_embedded<O: Orient>(
+    o: O,
+    apex: P3,
+    mut rim: impl Iterator<Item = (P3, P3)>,
+    closed: bool,
+) -> bool {
+    let finite = |p: &P3| p.iter().all(|x| x.is_finite());
+    let Some((next, prev)) = rim.next() else {
+        return false;
+    };
+    if !finite(&apex) {
+        return false;
+    }
+    // The axis of the first face's normal: on a fan that is nearly flat every face projects
+    // well along it, and on any other the orientations tell.
+    let n = cross(sub(next, apex), sub(prev, apex));
+    let (x, y, z) = (n[0].abs(), n[1].abs(), n[2].abs());
+    let k = if x >= y && x >= z {
+        0
+    } else if y >= z {
+        1
+    } else {
+        2
+    };
+    let a = proj(apex, k);
+    let (mut sign, mut up, mut down) = (0, 0u32, 0u32);
+    for (next, prev) in std::iter::once((next, prev)).chain(rim) {
+        if !finite(&next) || !finite(&prev) {
+            return false;
+        }
+        let (b, c) = (proj(next, k), proj(prev, k));
+        let s = o.orient2d(a, b, c);
+        if s == 0 || s == -sign {
+            return false;
+        }
+        sign = s;
+        up += (b[1] < a[1] && c[1] >= a[1]) as u32;
+        down += (b[1] >= a[1] && c[1] < a[1]) as u32;
+    }
+    sign != 0 && if closed { up == 1 } else { up + down <= 1 }
+}
+
 /// Whether `a, b, c` are collinear or coincident (decided exactly; non-finite input counts as
 /// degenerate). A triangle with this property has no plane and no interior.
 #[cfg_attr(not(test), allow(dead_code))] // for the mesher's checks; tested here
@@ -1057,5 +1124,129 @@ mod tests {
             Some(any)
         };
         Some(hit(a, b)? || hit(b, a)?)
+    }
+
+    /// The rim of a fan round the origin: points at the given angles (degrees), radius 1,
+    /// heights `z`; faces `origin → rim[i] → rim[i + 1]` (closing the cycle if `closed`).
+    fn fan(angles: &[f64], z: &[f64], closed: bool) -> Vec<(P3, P3)> {
+        let at = |i: usize| {
+            let a = angles[i].to_radians();
+            [a.cos(), a.sin(), z[i % z.len()]]
+        };
+        let faces = if closed {
+            angles.len()
+        } else {
+            angles.len() - 1
+        };
+        (0..faces)
+            .map(|i| (at(i), at((i + 1) % angles.len())))
+            .collect()
+    }
+
+    fn embedded(rim: &[(P3, P3)], closed: bool) -> bool {
+        fan_is_embedded(InRange, [0.0; 3], rim.iter().copied(), closed)
+    }
+
+    #[test]
+    fn fans_that_turn_once_are_certified_and_others_are_not() {
+        let hexagon = [0.0, 60.0, 120.0, 180.0, 240.0, 300.0];
+        let flat = [0.0];
+        let wavy = [0.3, -0.2, 0.4, -0.1, 0.2, -0.3];
+        assert!(embedded(&fan(&hexagon, &flat, true), true));
+        assert!(embedded(&fan(&hexagon, &wavy, true), true));
+        // Turning twice round the apex: every other face overlaps another.
+        let twice: Vec<f64> = (0..9).map(|i| 80.0 * i as f64).collect();
+        assert!(!embedded(&fan(&twice, &flat, true), true));
+        // A face turned over.
+        let mut flipped = fan(&hexagon, &wavy, true);
+        flipped[2] = (flipped[2].1, flipped[2].0);
+        assert!(!embedded(&flipped, true));
+        // Open fans: a half-turn is certified, and 300° from 10°; one that turns more than
+        // once is not, and nor is 300° from 170°, which crosses the line both ways (the test
+        // is sufficient only).
+        assert!(embedded(
+            &fan(&[10.0, 70.0, 130.0, 190.0], &wavy, false),
+            false
+        ));
+        let over: Vec<f64> = (0..8).map(|i| 60.0 * i as f64).collect();
+        assert!(!embedded(&fan(&over, &flat, false), false));
+        let wide = |from: f64| -> Vec<f64> { (0..6).map(|i| from + 60.0 * i as f64).collect() };
+        assert!(embedded(&fan(&wide(10.0), &flat, false), false));
+        assert!(!embedded(&fan(&wide(170.0), &flat, false), false));
+        // A flat (collinear) face, a non-finite corner, no face at all.
+        let mut flat_face = fan(&hexagon, &flat, true);
+        flat_face[0].1 = [2.0, 0.0, 0.0];
+        assert!(!embedded(&flat_face, true));
+        let mut nan = fan(&hexagon, &flat, true);
+        nan[3].0[2] = f64::NAN;
+        assert!(!embedded(&nan, true));
+        assert!(!embedded(&[], true));
+    }
+
+    proptest::proptest! {
+        #![proptest_config(proptest::prelude::ProptestConfig {
+            cases: 512, ..proptest::prelude::ProptestConfig::default()
+        })]
+
+        /// A certified fan has no intersecting pair of faces (checked pair by pair with
+        /// `faces_intersect`): random rims, in order or not, flat or folded, closed or open.
+        #[test]
+        fn a_certified_fan_has_no_intersecting_faces(seed in proptest::prelude::any::<u64>()) {
+            let mut rng = XorShift64::new(seed);
+            let k = 3 + (rng.next_u64() % 8) as usize;
+            let closed = rng.next_u64().is_multiple_of(2);
+            let sorted = !rng.next_u64().is_multiple_of(3);
+            let steep = rng.uniform(0.0, 3.0);
+            let mut p: Vec<P3> = vec![[0.0; 3]];
+            let mut angle = rng.uniform(0.0, 360.0);
+            for _ in 0..k {
+                angle = if sorted {
+                    angle + rng.uniform(5.0, 720.0 / k as f64)
+                } else {
+                    rng.uniform(0.0, 360.0)
+                };
+                let (r, a) = (rng.uniform(0.2, 2.0), angle.to_radians());
+                // On a lattice of 1/8 now and then, so that exact ties occur.
+                let q = [r * a.cos(), r * a.sin(), rng.uniform(-steep, steep)];
+                let on_lattice = rng.next_u64().is_multiple_of(4);
+                p.push(if on_lattice { q.map(|x| (x * 8.0).round() / 8.0) } else { q });
+            }
+            let faces: Vec<[u32; 3]> = (1..=k as u32)
+                .filter(|&i| closed || i < k as u32)
+                .map(|i| [0, i, i % k as u32 + 1])
+                .collect();
+            let rim: Vec<(P3, P3)> =
+                faces.iter().map(|f| (p[f[1] as usize], p[f[2] as usize])).collect();
+            if embedded(&rim, closed) {
+                for (i, &f) in faces.iter().enumerate() {
+                    for &g in &faces[i + 1..] {
+                        proptest::prop_assert!(!faces_intersect(&p, f, g), "{p:?} {f:?} {g:?}");
+                    }
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn random_fans_are_certified_and_refused_both() {
+        // The property above is not vacuous: of the fans it draws, some are certified and
+        // some are not.
+        let mut rng = XorShift64::new(7);
+        let (mut yes, mut no) = (0, 0);
+        for _ in 0..200 {
+            let k = 3 + (rng.next_u64() % 8) as usize;
+            let angles: Vec<f64> = (0..k).map(|_| rng.uniform(0.0, 360.0)).collect();
+            let mut sorted = angles.clone();
+            sorted.sort_by(f64::total_cmp);
+            let z = [rng.uniform(-0.5, 0.5)];
+            for a in [angles, sorted] {
+                if embedded(&fan(&a, &z, true), true) {
+                    yes += 1;
+                } else {
+                    no += 1;
+                }
+            }
+        }
+        assert!(yes > 50 && no > 50, "{yes} certified, {no} not");
     }
 }
