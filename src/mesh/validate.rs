@@ -438,6 +438,18 @@ pub(crate) fn validate_listing(p: &[P3], tris: &[[u32; 3]]) -> Listed {
     }
 }
 
+/// The corners of face `t` after its corner `v`, in the face's order: `v → next → prev`.
+#[inline]
+fn others(t: [u32; 3], v: u32) -> (u32, u32) {
+    if t[0] == v {
+        (t[1], t[2])
+    } else if t[1] == v {
+        (t[2], t[0])
+    } else {
+        (t[0], t[1])
+    }
+}
+
 /// The mesh in validation's layout (see [`validate`]), with points on which the predicates
 /// are exact.
 #[derive(Clone, Copy)]
@@ -518,14 +530,7 @@ fn topology<O: Orient>(o: O, m: Local<'_>, v: &mut Validation) -> (Vec<(u32, u32
         v.vertices += 1;
         ends.clear();
         for (ls, &f) in slots[s..e].iter().enumerate() {
-            let t = faces[f as usize];
-            let (next, prev) = if t[0] == vtx32 {
-                (t[1], t[2])
-            } else if t[1] == vtx32 {
-                (t[2], t[0])
-            } else {
-                (t[0], t[1])
-            };
+            let (next, prev) = others(faces[f as usize], vtx32);
             let slot = (ls as u64) << 1;
             ends.push((next as u64) << 32 | slot | 1);
             ends.push((prev as u64) << 32 | slot);
@@ -583,14 +588,7 @@ fn topology<O: Orient>(o: O, m: Local<'_>, v: &mut Validation) -> (Vec<(u32, u32
             v.non_manifold_vertices.push(old(vtx32));
         } else if manifold && (open_edges == 0 || open_edges == 2) {
             let rim = slots[s..e].iter().map(|&f| {
-                let t = faces[f as usize];
-                let (next, prev) = if t[0] == vtx32 {
-                    (t[1], t[2])
-                } else if t[1] == vtx32 {
-                    (t[2], t[0])
-                } else {
-                    (t[0], t[1])
-                };
+                let (next, prev) = others(faces[f as usize], vtx32);
                 (m.p[next as usize], m.p[prev as usize])
             });
             embedded[vtx] = fan_is_embedded(o, m.p[vtx], rim, open_edges == 0);
