@@ -295,35 +295,23 @@ pub fn run_observed<T: Scalar, F: NormalField<T>>(
     let improve = params.mode == Mode::Default;
     // The axis of the hole the field knows, which no face may meet.
     let axis = params.hole.map(|h| h.axis());
-    // A mesh that is stitched is flipped to surface Delaunay once it is whole, not as a chart.
-    let (mut mesh, chart) =
-        triangulate::triangulate(&samples, params.close, improve && !params.close)?;
-    // The mesh's vertices in the working precision, found by provenance.
-    let mut vertices = triangulate::sample_vertices(&samples, &mesh);
-    let stitched = if params.close {
-        observe(Progress::at(
-            Stage::Stitching,
-            mesh.vertices.len(),
-            curves,
-            mesh.triangles.len(),
-        ));
-        let stitched = triangulate::stitch(field, params, &samples, &mut mesh, &mut vertices);
-        if improve {
-            triangulate::flip_to_surface_delaunay(&mut mesh, axis);
-        }
-        stitched
-    } else {
-        Default::default()
-    };
+    let (mut mesh, chart, mut vertices, stitched) =
+        assemble(field, params, &samples, improve, axis, observe)?;
     lap(&mut timings.triangulating, &mut since);
-    // Where every vertex was before relaxation: a relaxation move that makes faces cross is
-    // taken back.
-    let before = improve.then(|| triangulate::Before {
-        positions: mesh.vertices.clone(),
-        normals: mesh.normals.clone(),
-        working: vertices.clone(),
-        triangles: mesh.triangles.clone(),
-    });
+    // Where every vertex was before relaxation, for taking back a relaxation move that makes
+    // faces cross. Everything up to here is deterministic, so that state is rebuilt from the
+    // samples on the rare run that needs it rather than copied on every run (a copy of the
+    // whole mesh held through relaxation and validation: 48 MB at 10⁶ triangles).
+    let before_relaxation = || {
+        let (mesh, _, working, _) =
+            assemble(field, params, &samples, improve, axis, &|_| {}).ok()?;
+        Some(triangulate::Before {
+            positions: mesh.vertices,
+            normals: mesh.normals,
+            working,
+            triangles: mesh.triangles,
+        })
+    };
     if improve {
         observe(Progress::at(
             Stage::Improving,
@@ -366,14 +354,15 @@ pub fn run_observed<T: Scalar, F: NormalField<T>>(
     // Crossings that relaxation made are first relaxed away again with their vertices pinned
     // (not after refinement, which added vertices since).
     let mut pinned = 0;
-    if let (false, Some(b), None) = (
-        validation.self_intersections.is_empty(),
-        before.as_ref(),
-        refinement.as_ref(),
-    ) {
-        pinned = triangulate::relax_pinned(field, params, &mut mesh, &mut vertices, b, |p, t| {
-            mesh::crossings(p, t)
-        });
+    let mut before = None;
+    if improve && refinement.is_none() && !validation.self_intersections.is_empty() {
+        before = before_relaxation();
+        if let Some(b) = &before {
+            pinned =
+                triangulate::relax_pinned(field, params, &mut mesh, &mut vertices, b, |p, t| {
+                    mesh::crossings(p, t)
+                });
+        }
         if pinned > 0 {
             (validation, boundary) = mesh::validate_with_boundary(&mesh);
         }
@@ -389,6 +378,9 @@ pub fn run_observed<T: Scalar, F: NormalField<T>>(
     }
     let mut untangled = triangulate::Untangled::default();
     if !validation.self_intersections.is_empty() {
+        if improve && before.is_none() {
+            before = before_relaxation();
+        }
         untangled = triangulate::untangle(&mut mesh, &mut vertices, before.as_ref(), |p, t| {
             mesh::crossings(p, t)
         });
@@ -428,6 +420,49 @@ pub fn run_observed<T: Scalar, F: NormalField<T>>(
         params: resolved,
         timings,
     })
+}
+
+/// The mesh as it stands before relaxation: the samples' chart triangulation, stitched
+/// where fronts meet (when the run closes its mesh) and then flipped to surface Delaunay
+/// (when it is improved), with its vertices in the working precision and what the stitching
+/// did. A function of its arguments alone ([`run_observed`] rebuilds it to take relaxation
+/// moves back).
+type Assembled<T> = (
+    Mesh,
+    triangulate::ChartTriangulation,
+    Vec<scalar::Vec3<T>>,
+    triangulate::Stitched,
+);
+
+fn assemble<T: Scalar, F: NormalField<T>>(
+    field: &F,
+    params: &Resolved,
+    samples: &sample::Samples<T>,
+    improve: bool,
+    axis: Option<[[f64; 3]; 2]>,
+    observe: &dyn Fn(Progress),
+) -> Result<Assembled<T>, MeshError> {
+    // A mesh that is stitched is flipped to surface Delaunay once it is whole, not as a chart.
+    let (mut mesh, chart) =
+        triangulate::triangulate(samples, params.close, improve && !params.close)?;
+    // The mesh's vertices in the working precision, found by provenance.
+    let mut vertices = triangulate::sample_vertices(samples, &mesh);
+    let stitched = if params.close {
+        observe(Progress::at(
+            Stage::Stitching,
+            mesh.vertices.len(),
+            samples.curves.len(),
+            mesh.triangles.len(),
+        ));
+        let stitched = triangulate::stitch(field, params, samples, &mut mesh, &mut vertices);
+        if improve {
+            triangulate::flip_to_surface_delaunay(&mut mesh, axis);
+        }
+        stitched
+    } else {
+        Default::default()
+    };
+    Ok((mesh, chart, vertices, stitched))
 }
 
 /// Meshes the surface of `field` with `params`.
