@@ -78,18 +78,6 @@ impl Aabb {
             && o.min[2] <= self.max[2]
     }
 
-    /// [`Aabb::overlaps`] with every comparison evaluated, for loops that must not branch on
-    /// each pair.
-    #[inline]
-    fn overlaps_branchless(&self, o: &Aabb) -> bool {
-        (self.min[0] <= o.max[0])
-            & (o.min[0] <= self.max[0])
-            & (self.min[1] <= o.max[1])
-            & (o.min[1] <= self.max[1])
-            & (self.min[2] <= o.max[2])
-            & (o.min[2] <= self.max[2])
-    }
-
     /// Whether every coordinate is finite.
     #[inline]
     pub fn is_finite(&self) -> bool {
@@ -104,15 +92,88 @@ impl Aabb {
     }
 }
 
-/// A cell size for `boxes`: the median longest side of the finite boxes, or a fallback when
-/// that is zero (most boxes points) or undefined.
-pub(crate) fn cell_size(boxes: &[Aabb]) -> f64 {
-    let mut ext: Vec<f64> = boxes
-        .iter()
-        .filter(|b| b.is_finite())
-        .map(Aabb::extent)
-        .filter(|e| e.is_finite())
-        .collect();
+/// A closed axis-aligned box in `f32`, enclosing the [`Aabb`] it was made from: half the
+/// memory of an `Aabb` (the broad phase of a validation holds one per face: 24 MB at 10⁶
+/// faces). Bounds are moved outwards and clamped to `±f32::MAX`: a lower bound of one box is
+/// still at most an upper bound of another where it was (clamping is monotone), so boxes
+/// that overlap still do. A box with a NaN coordinate stays non-finite.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct Box32 {
+    min: [f32; 3],
+    max: [f32; 3],
+}
+
+impl Box32 {
+    /// An `f32` box holding `b` (clamped to the finite `f32` range), a few `f32` ulps wider.
+    #[inline]
+    pub fn enclosing(b: &Aabb) -> Box32 {
+        // Without a branch on the rounding (it goes either way at random, and every face's
+        // six bounds go through here): moved out by 2⁻²² of the value and by twice the
+        // least subnormal `f32` before rounding to nearest, which moves a value by at most
+        // half of that, the bound ends up outside. The clamps keep NaN.
+        const RELATIVE: f64 = 1.0 / (1u64 << 22) as f64;
+        const ABSOLUTE: f64 = 2.0 * 1.401_298_464_324_817e-45;
+        let down = |x: f64| ((x - x.abs() * RELATIVE - ABSOLUTE) as f32).clamp(-f32::MAX, f32::MAX);
+        let up = |x: f64| ((x + x.abs() * RELATIVE + ABSOLUTE) as f32).clamp(-f32::MAX, f32::MAX);
+        Box32 {
+            min: b.min.map(down),
+            max: b.max.map(up),
+        }
+    }
+
+    /// Lowest corner.
+    #[inline]
+    fn lo(&self) -> P3 {
+        self.min.map(f64::from)
+    }
+
+    /// Highest corner.
+    #[inline]
+    fn hi(&self) -> P3 {
+        self.max.map(f64::from)
+    }
+
+    /// Whether the closed boxes have a common point (never for a non-finite box).
+    #[inline]
+    fn overlaps(&self, o: &Box32) -> bool {
+        self.min[0] <= o.max[0]
+            && o.min[0] <= self.max[0]
+            && self.min[1] <= o.max[1]
+            && o.min[1] <= self.max[1]
+            && self.min[2] <= o.max[2]
+            && o.min[2] <= self.max[2]
+    }
+
+    /// [`Box32::overlaps`] with every comparison evaluated, for loops that must not branch
+    /// on each pair.
+    #[inline]
+    fn overlaps_branchless(&self, o: &Box32) -> bool {
+        (self.min[0] <= o.max[0])
+            & (o.min[0] <= self.max[0])
+            & (self.min[1] <= o.max[1])
+            & (o.min[1] <= self.max[1])
+            & (self.min[2] <= o.max[2])
+            & (o.min[2] <= self.max[2])
+    }
+
+    /// Whether every coordinate is finite.
+    #[inline]
+    fn is_finite(&self) -> bool {
+        self.min.iter().chain(&self.max).all(|x| x.is_finite())
+    }
+
+    /// The longest side (in `f64`, where it cannot overflow).
+    pub fn extent(&self) -> f64 {
+        (0..3)
+            .map(|k| f64::from(self.max[k]) - f64::from(self.min[k]))
+            .fold(0.0, f64::max)
+    }
+}
+
+/// A cell size for boxes of longest sides `extents` (of the finite boxes): their median, or
+/// a fallback when that is zero (most boxes points) or undefined.
+pub(crate) fn cell_size(extents: impl IntoIterator<Item = f64>) -> f64 {
+    let mut ext: Vec<f64> = extents.into_iter().filter(|e| e.is_finite()).collect();
     if ext.is_empty() {
         return 1.0;
     }
@@ -261,7 +322,7 @@ const FLAG_BITS: u32 = 3;
 /// tell without reading the boxes. Sorting on the guest flag too puts a cell's own faces
 /// before its guests, so guest pairs (which meet at their own level) are never visited.
 pub(crate) struct PairGrid {
-    boxes: Vec<Aabb>,
+    boxes: Vec<Box32>,
     /// Entries sorted by key, faces ascending within a cell.
     filed: Vec<u64>,
     /// Start of each occupied cell's entries in `filed`, then the end.
@@ -275,7 +336,7 @@ pub(crate) struct PairGrid {
 impl PairGrid {
     /// Files `boxes` in levels of cells with base side `cell` (see [`cell_size`]). Boxes in
     /// a spatial order ([`spatial_order`]) make the pair loop read nearby memory.
-    pub fn new(boxes: Vec<Aabb>, cell: f64) -> PairGrid {
+    pub fn new(boxes: Vec<Box32>, cell: f64) -> PairGrid {
         let id_bits = 64 - (boxes.len() as u64).leading_zeros();
         let guest_bit = id_bits + FLAG_BITS;
         let tag_bits = guest_bit + 1;
@@ -283,8 +344,8 @@ impl PairGrid {
         let (mut gmin, mut gmax) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
         for b in boxes.iter().filter(|b| b.is_finite()) {
             for k in 0..3 {
-                gmin[k] = gmin[k].min(b.min[k]);
-                gmax[k] = gmax[k].max(b.max[k]);
+                gmin[k] = gmin[k].min(f64::from(b.min[k]));
+                gmax[k] = gmax[k].max(f64::from(b.max[k]));
             }
         }
         // Levels whose keys fit beside the tags in 64 bits; coarser cells if they do not
@@ -338,7 +399,7 @@ impl PairGrid {
             }
             if let Some(bits) = occupied[l].as_mut() {
                 let lev = &levels[l];
-                let (lo, hi) = (lev.cell(&b.min), lev.cell(&b.max));
+                let (lo, hi) = (lev.cell(&b.lo()), lev.cell(&b.hi()));
                 for x in lo[0]..=hi[0] {
                     for y in lo[1]..=hi[1] {
                         for z in lo[2]..=hi[2] {
@@ -370,7 +431,7 @@ impl PairGrid {
                     }
                     let guest = lv > l;
                     let id = (guest as u64) << guest_bit | (i as u64) << FLAG_BITS;
-                    let (lo, hi) = (lev.cell(&b.min), lev.cell(&b.max));
+                    let (lo, hi) = (lev.cell(&b.lo()), lev.cell(&b.hi()));
                     for x in lo[0]..=hi[0] {
                         let (mx, fx) = (spread3(x as u64) << 2, (x == lo[0]) as u64);
                         for y in lo[1]..=hi[1] {
@@ -780,7 +841,12 @@ mod tests {
         boxes
     }
 
-    fn brute(boxes: &[Aabb]) -> Vec<(u32, u32)> {
+    /// The longest sides of the finite boxes, for [`cell_size`].
+    fn extents(boxes: &[Aabb]) -> impl Iterator<Item = f64> + '_ {
+        boxes.iter().filter(|b| b.is_finite()).map(Aabb::extent)
+    }
+
+    fn brute(boxes: &[Box32]) -> Vec<(u32, u32)> {
         let mut v = Vec::new();
         for i in 0..boxes.len() {
             for j in i + 1..boxes.len() {
@@ -796,8 +862,9 @@ mod tests {
     fn pair_grid_finds_every_overlapping_pair_once() {
         let mut rng = XorShift64::new(3);
         for (n, outliers) in [(0, 0), (1, 0), (50, 0), (400, 5), (400, 40), (400, 200)] {
-            let boxes = random_boxes(&mut rng, n, outliers);
-            for cell in [cell_size(&boxes), 1e-3, 0.3, 10.0, f64::NAN, 0.0] {
+            let exact = random_boxes(&mut rng, n, outliers);
+            let boxes: Vec<Box32> = exact.iter().map(Box32::enclosing).collect();
+            for cell in [cell_size(extents(&exact)), 1e-3, 0.3, 10.0, f64::NAN, 0.0] {
                 let grid = PairGrid::new(boxes.clone(), cell);
                 let mut got = Vec::new();
                 grid.for_each_pair(|i, j| {
@@ -809,15 +876,89 @@ mod tests {
                 got.dedup();
                 assert_eq!(len, got.len(), "a pair was reported twice");
                 assert_eq!(got, brute(&boxes), "n = {n}, cell = {cell}");
+                // Every pair of overlapping `f64` boxes is among them.
+                for (i, a) in exact.iter().enumerate() {
+                    for (j, b) in exact.iter().enumerate().skip(i + 1) {
+                        if a.overlaps(b) {
+                            assert!(got.binary_search(&(i as u32, j as u32)).is_ok());
+                        }
+                    }
+                }
             }
         }
+    }
+
+    #[test]
+    fn f32_boxes_enclose_their_boxes_and_keep_every_overlap() {
+        let mut rng = XorShift64::new(23);
+        let special = [
+            0.0,
+            -0.0,
+            1.0,
+            0.1,
+            -0.1,
+            1e-45,
+            -1e-45,
+            1e-300,
+            -1e-300,
+            3.4e38,
+            3.5e38,
+            -3.5e38,
+            1e300,
+            -1e300,
+            f64::MAX,
+            f64::MIN,
+        ];
+        let mut values = special.to_vec();
+        values.extend(
+            (0..2000)
+                .map(|_| f64::from_bits(rng.next_u64()))
+                .filter(|x| x.is_finite()),
+        );
+        values.extend((0..2000).map(|_| rng.uniform(-10.0, 10.0)));
+        for &x in &values {
+            for &y in &values[..64] {
+                let exact = Aabb {
+                    min: [x.min(y); 3],
+                    max: [x.max(y); 3],
+                };
+                let b = Box32::enclosing(&exact);
+                assert!(b.is_finite(), "{x:e} {y:e}");
+                let (lo, hi) = (b.lo()[0], b.hi()[0]);
+                // Outwards, except where clamped to the f32 range.
+                assert!(lo <= exact.min[0] || lo == -f32::MAX as f64, "{x:e} {y:e}");
+                assert!(hi >= exact.max[0] || hi == f32::MAX as f64, "{x:e} {y:e}");
+                // Loose by a few ulps at most (where not clamped).
+                if (1e-37..=1e38).contains(&exact.min[0].abs()) {
+                    assert!(
+                        exact.min[0] - lo <= 1e-6 * exact.min[0].abs(),
+                        "{x:e} {y:e}"
+                    );
+                }
+                // A point box at x overlaps exactly the boxes that hold x, and more only where
+                // rounding or clamping merged bounds.
+                let point = Aabb {
+                    min: [x; 3],
+                    max: [x; 3],
+                };
+                if exact.overlaps(&point) {
+                    assert!(b.overlaps(&Box32::enclosing(&point)), "{x:e} {y:e}");
+                }
+            }
+        }
+        let nan = Box32::enclosing(&Aabb::of_triangle(&[
+            [f64::NAN, 0.0, 0.0],
+            [0.0; 3],
+            [0.0; 3],
+        ]));
+        assert!(!nan.is_finite());
     }
 
     #[test]
     fn face_grid_queries_match_brute_force() {
         let mut rng = XorShift64::new(9);
         let boxes = random_boxes(&mut rng, 300, 6);
-        let mut grid = FaceGrid::new(cell_size(&boxes));
+        let mut grid = FaceGrid::new(cell_size(extents(&boxes)));
         let mut out = Vec::new();
         for (i, b) in boxes.iter().enumerate() {
             grid.query(b, &mut out);
@@ -901,8 +1042,12 @@ mod tests {
         };
         let mut boxes = vec![unit(1.0); 9];
         boxes.push(unit(1e9));
-        assert_eq!(cell_size(&boxes), 1.0);
-        assert_eq!(cell_size(&[unit(0.0), unit(0.0), unit(8.0)]), 8.0 / 1024.0);
-        assert_eq!(cell_size(&[]), 1.0);
+        assert_eq!(cell_size(extents(&boxes)), 1.0);
+        assert_eq!(
+            cell_size(extents(&[unit(0.0), unit(0.0), unit(8.0)])),
+            8.0 / 1024.0
+        );
+        assert_eq!(cell_size(extents(&[])), 1.0);
+        assert_eq!(cell_size([f64::NAN, f64::INFINITY, 2.0]), 2.0);
     }
 }

@@ -18,7 +18,7 @@
 //! count or the lowest offenders, so the report is the same for any number of threads.
 
 use super::Mesh;
-use crate::geom::grid::{cell_size, radix_sort, spatial_order, Aabb, PairGrid};
+use crate::geom::grid::{cell_size, radix_sort, spatial_order, Aabb, Box32, PairGrid};
 use crate::geom::intersect::{fan_is_embedded, is_collinear, planar_faces_intersect, PlanarFace};
 use crate::geom::predicates::{scale, Checked, Exponents, InRange, Orient, P3};
 use crate::geom::rows::rows_by_corner;
@@ -648,18 +648,20 @@ fn prepare<O: Orient + Sync>(o: O, m: Local<'_>) -> Prepared {
     });
     let mut degenerate = Vec::new();
     let mut solid: Vec<u32> = Vec::with_capacity(m.geo.len());
-    let mut boxes: Vec<Aabb> = Vec::with_capacity(m.geo.len());
+    let mut boxes: Vec<Box32> = Vec::with_capacity(m.geo.len());
     for (&k, &flat) in m.geo.iter().zip(&collinear) {
         if flat {
             degenerate.push(k);
         } else {
             solid.push(k);
-            boxes.push(Aabb::of_triangle(&corners(m.faces[k as usize])));
+            boxes.push(Box32::enclosing(&Aabb::of_triangle(&corners(
+                m.faces[k as usize],
+            ))));
         }
     }
     // Cells of 1.5 median boxes: fewer entries per face than 1, fewer faces per cell than 2
     // (the fastest of the three on the benchmark meshes).
-    let cell = 1.5 * cell_size(&boxes);
+    let cell = 1.5 * cell_size(boxes.iter().map(Box32::extent));
     Prepared {
         degenerate,
         ids: solid.iter().map(|&k| m.faces[k as usize]).collect(),
