@@ -449,6 +449,9 @@ impl PairGrid {
                     }
                 }
             }
+            // A chunk that outgrew its guess holds up to twice its entries; trimmed (in place)
+            // before they are gathered, the chunks take no more than the gathered array.
+            filed.shrink_to_fit();
             filed
         };
         let n = boxes.len();

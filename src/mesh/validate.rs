@@ -641,8 +641,6 @@ struct Prepared {
     degenerate: Vec<u32>,
     /// The other faces with finite corners; the grid's face `i` is `solid[i]`.
     solid: Vec<u32>,
-    /// The corners of `solid[i]`, at `i`: the pair loop reads them for every pair.
-    ids: Vec<[u32; 3]>,
     /// Their overlapping boxes.
     grid: PairGrid,
 }
@@ -673,7 +671,6 @@ fn prepare<O: Orient + Sync>(o: O, m: Local<'_>) -> Prepared {
     let cell = 1.5 * cell_size(boxes.iter().map(Box32::extent));
     Prepared {
         degenerate,
-        ids: solid.iter().map(|&k| m.faces[k as usize]).collect(),
         solid,
         grid: PairGrid::new(boxes, cell),
     }
@@ -690,12 +687,11 @@ fn crossings<O: Orient + Sync>(
     prepared: &Prepared,
     embedded: &[bool],
 ) -> Vec<(u32, u32)> {
-    let Prepared {
-        solid, grid, ids, ..
-    } = prepared;
+    let Prepared { solid, grid, .. } = prepared;
     let corners = |t: [u32; 3]| [m.p[t[0] as usize], m.p[t[1] as usize], m.p[t[2] as usize]];
     let test = |i: u32, j: u32, out: &mut Vec<(u32, u32)>| {
-        let (f, g) = (ids[i as usize], ids[j as usize]);
+        let (a, b) = (solid[i as usize], solid[j as usize]);
+        let (f, g) = (m.faces[a as usize], m.faces[b as usize]);
         let (mut shared, mut certified) = (0, false);
         for x in f {
             if g.contains(&x) {
@@ -706,7 +702,6 @@ fn crossings<O: Orient + Sync>(
         if certified && shared < 3 {
             return;
         }
-        let (a, b) = (solid[i as usize], solid[j as usize]);
         let (pf, pg) = (
             PlanarFace::new(o, f, corners(f)),
             PlanarFace::new(o, g, corners(g)),
