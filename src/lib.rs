@@ -422,11 +422,8 @@ pub fn run_observed<T: Scalar, F: NormalField<T>>(
     })
 }
 
-/// The mesh as it stands before relaxation: the samples' chart triangulation, stitched
-/// where fronts meet (when the run closes its mesh) and then flipped to surface Delaunay
-/// (when it is improved), with its vertices in the working precision and what the stitching
-/// did. A function of its arguments alone ([`run_observed`] rebuilds it to take relaxation
-/// moves back).
+/// What [`assemble`] gives: the mesh, its chart triangulation, its vertices in the working
+/// precision and what the stitching did.
 type Assembled<T> = (
     Mesh,
     triangulate::ChartTriangulation,
@@ -434,6 +431,10 @@ type Assembled<T> = (
     triangulate::Stitched,
 );
 
+/// The mesh as it stands before relaxation: the samples' chart triangulation, stitched
+/// where fronts meet (when the run closes its mesh) and then flipped to surface Delaunay
+/// (when it is improved). A function of its arguments alone: [`run_observed`] builds it
+/// again to take relaxation moves back.
 fn assemble<T: Scalar, F: NormalField<T>>(
     field: &F,
     params: &Resolved,
