@@ -211,15 +211,7 @@ pub(crate) fn fan_is_embedded<O: Orient>(
     }
     // The axis of the first face's normal: on a fan that is nearly flat every face projects
     // well along it, and on any other the orientations tell.
-    let n = cross(sub(next, apex), sub(prev, apex));
-    let (x, y, z) = (n[0].abs(), n[1].abs(), n[2].abs());
-    let k = if x >= y && x >= z {
-        0
-    } else if y >= z {
-        1
-    } else {
-        2
-    };
+    let k = normal_axis(apex, next, prev);
     let a = proj(apex, k);
     let (mut sign, mut up, mut down) = (0, 0u32, 0u32);
     for (next, prev) in std::iter::once((next, prev)).chain(rim) {
@@ -296,20 +288,27 @@ fn proj(p: P3, k: usize) -> [f64; 2] {
     [p[(k + 1) % 3], p[(k + 2) % 3]]
 }
 
-/// An axis along which triangle `abc` projects to a non-degenerate triangle, or `None` if the
-/// corners are collinear (the three projected areas are the components of the normal, so
-/// they all vanish exactly then). The float normal's largest component is tried first, so
-/// one exact `orient2d` usually decides.
-fn drop_axis<O: Orient>(o: O, a: P3, b: P3, c: P3) -> Option<usize> {
+/// The axis of the largest component of triangle `abc`'s float normal (ties to the lower
+/// axis): the one along which it projects largest.
+#[inline]
+fn normal_axis(a: P3, b: P3, c: P3) -> usize {
     let n = cross(sub(b, a), sub(c, a));
     let (x, y, z) = (n[0].abs(), n[1].abs(), n[2].abs());
-    let first = if x >= y && x >= z {
+    if x >= y && x >= z {
         0
     } else if y >= z {
         1
     } else {
         2
-    };
+    }
+}
+
+/// An axis along which triangle `abc` projects to a non-degenerate triangle, or `None` if the
+/// corners are collinear (the three projected areas are the components of the normal, so
+/// they all vanish exactly then). The float normal's largest component is tried first, so
+/// one exact `orient2d` usually decides.
+fn drop_axis<O: Orient>(o: O, a: P3, b: P3, c: P3) -> Option<usize> {
+    let first = normal_axis(a, b, c);
     let area = |k: usize| o.orient2d(proj(a, k), proj(b, k), proj(c, k));
     if area(first) != 0 {
         return Some(first);

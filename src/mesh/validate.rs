@@ -862,6 +862,16 @@ mod tests {
         pairs
     }
 
+    /// `p` with every point moved by up to `amount` along each axis.
+    fn perturbed(p: &[P3], rng: &mut XorShift64, amount: f64) -> Vec<P3> {
+        p.iter()
+            .map(|x| {
+                let d = rng.in_cube(amount);
+                [x[0] + d[0], x[1] + d[1], x[2] + d[2]]
+            })
+            .collect()
+    }
+
     fn check_against_brute_force(p: Vec<P3>, t: Vec<[u32; 3]>) -> Validation {
         let expected = brute_force(&p, &t);
         let v = mesh(p, t).validate();
@@ -951,14 +961,7 @@ mod tests {
         let mut rng = XorShift64::new(4);
         let mut found = 0;
         for amount in [0.02, 0.05, 0.1, 0.3] {
-            let q: Vec<P3> = p
-                .iter()
-                .map(|x| {
-                    let d = rng.in_cube(amount);
-                    [x[0] + d[0], x[1] + d[1], x[2] + d[2]]
-                })
-                .collect();
-            found += check_against_brute_force(q, t.clone())
+            found += check_against_brute_force(perturbed(&p, &mut rng, amount), t.clone())
                 .self_intersections
                 .count;
         }
@@ -993,14 +996,7 @@ mod tests {
                 let k = (rng.next_u64() % t.len() as u64) as usize;
                 t.swap_remove(k);
             }
-            let q: Vec<P3> = p
-                .iter()
-                .map(|x| {
-                    let d = rng.in_cube(amount);
-                    [x[0] + d[0], x[1] + d[1], x[2] + d[2]]
-                })
-                .collect();
-            check_against_brute_force(q, t);
+            check_against_brute_force(perturbed(&p, &mut rng, amount), t);
         }
 
         /// Renumbering vertices and reordering faces renames the offenders, nothing else.
