@@ -44,6 +44,7 @@ use crate::geom::vec3::{
     cross as cross3, dist as dist3, sub as sub3, turn_about, wider_than, FastHash,
 };
 use crate::model::LocalShape;
+use crate::par;
 use crate::params::Resolved;
 use crate::sample::{CurveEnd, Samples};
 use crate::scalar::{Scalar, Vec3};
@@ -105,13 +106,16 @@ pub fn triangulate<T: Scalar>(
     // chart is not the surface: fronts that met, or ended far apart. The stitching below
     // closes what is left between real neighbours.
     let spacing = local_spacing(samples);
-    triangles.retain(|t| {
+    let short = par::map(triangles.len(), par::MIN_CHEAP, |i| {
+        let t = triangles[i];
         let h = t.iter().map(|&v| spacing[v as usize]).fold(0.0, f64::max);
         (0..3).all(|k| {
             let (a, b) = (t[k] as usize, t[(k + 1) % 3] as usize);
             dist3(pos[a], pos[b]) <= CHART_EDGE_FACTOR * h
         })
     });
+    let mut short = short.into_iter();
+    triangles.retain(|_| short.next() == Some(true));
     let normals: Vec<[f64; 3]> = samples.normals.iter().map(|v| v.to_f64()).collect();
     // Chart triangles that turn far from the field normal lie where the chart folds over
     // (inserted curves' chart positions are interpolated): they go, with the triangles
@@ -449,12 +453,14 @@ fn drop_folds(pos: &[[f64; 3]], normals: &[[f64; 3]], triangles: &mut Vec<[u32; 
     let mut bad = vec![false; pos.len()];
     let mut any = false;
     let spread_limit = BRIDGE_DEG.to_radians().cos();
-    for &t in triangles.iter() {
-        if flip::agreement(pos, normals, t) < limit || bridges(normals, t, spread_limit) {
-            any = true;
-            for v in t {
-                bad[v as usize] = true;
-            }
+    let folds = par::map(triangles.len(), par::MIN_CHEAP, |i| {
+        let t = triangles[i];
+        flip::agreement(pos, normals, t) < limit || bridges(normals, t, spread_limit)
+    });
+    for (&t, _) in triangles.iter().zip(&folds).filter(|(_, &f)| f) {
+        any = true;
+        for v in t {
+            bad[v as usize] = true;
         }
     }
     if any {
@@ -729,22 +735,33 @@ fn chart_triangles(chart: &[[f64; 2]], front: &[u32]) -> Result<Vec<[u32; 3]>, M
             polygon.is_empty() || polygon.contains(c)
         }
     };
-    // One pass in spade's order, straight into the result: beside the triangulation itself
-    // (the peak of memory here), a list of face handles would cost as much as the result.
-    let triangles = cdt
-        .inner_faces()
-        .filter_map(|face| {
-            let [a, b, c] = face.vertices();
-            let (pa, pb, pc) = (a.position(), b.position(), c.position());
-            let centroid = [
-                (pa.x + pb.x + pc.x) / 3.0 / unit,
-                (pa.y + pb.y + pc.y) / 3.0 / unit,
-            ];
-            (inside(centroid) && !rounding_sliver(pa, pb, pc))
-                .then(|| [a.data().index, b.data().index, c.data().index])
-        })
-        .collect();
-    Ok(triangles)
+    let kept = |face: spade::handles::FaceHandle<'_, _, ChartVertex, _, _, _>| {
+        let [a, b, c] = face.vertices();
+        let (pa, pb, pc) = (a.position(), b.position(), c.position());
+        let centroid = [
+            (pa.x + pb.x + pc.x) / 3.0 / unit,
+            (pa.y + pb.y + pc.y) / 3.0 / unit,
+        ];
+        (inside(centroid) && !rounding_sliver(pa, pb, pc))
+            .then(|| [a.data().index, b.data().index, c.data().index])
+    };
+    // Reading the faces out of spade's DCEL is a walk through memory in no spatial order
+    // (a tenth of a 10⁵-triangle run's chart triangulation), so large charts are read in
+    // chunks side by side, in spade's order all the same.
+    let faces = cdt.num_inner_faces();
+    let chunks = if faces >= par::MIN_CHEAP { 16 } else { 1 };
+    if chunks == 1 {
+        return Ok(cdt.inner_faces().filter_map(kept).collect());
+    }
+    let handles: Vec<_> = cdt.fixed_inner_faces().collect();
+    let parts = par::map(chunks, 2, |c| {
+        handles[c * faces / chunks..(c + 1) * faces / chunks]
+            .iter()
+            .filter_map(|&h| kept(cdt.face(h)))
+            .collect::<Vec<_>>()
+    });
+    drop(handles);
+    Ok(parts.concat())
 }
 
 /// Whether the chart triangle's area is at the level of rounding: three points on a line,

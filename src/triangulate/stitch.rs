@@ -94,6 +94,7 @@ use crate::geom::rows::{compressed_rows, rows_by_corner};
 use crate::geom::union_find::UnionFind;
 use crate::geom::vec3::{cross, dist, dot, sub, turn_about, FastHash};
 use crate::mesh::{Mesh, Provenance};
+use crate::par;
 use crate::params::Mode;
 use crate::scalar::{Scalar, Vec3};
 use crate::trace::{self, StepConfig};
@@ -859,12 +860,17 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
         let n = pos.len();
         let edges = EdgeSet::new(n, &tris);
         let mut boundary = Boundary::new(n);
-        for t in &tris {
-            for k in 0..3 {
-                let (a, b) = (t[k], t[(k + 1) % 3]);
-                if !edges.contains(b, a) {
-                    boundary.insert(a, b);
-                }
+        // Which sides of each triangle are on the boundary (bit `k`: the side from corner `k`),
+        // found side by side; the few boundary edges are then filed in triangle order.
+        let open_sides = par::map(tris.len(), par::MIN_CHEAP, |i| {
+            let t = tris[i];
+            (0..3).fold(0u8, |m, k| {
+                m | u8::from(!edges.contains(t[(k + 1) % 3], t[k])) << k
+            })
+        });
+        for (t, &m) in tris.iter().zip(&open_sides).filter(|(_, &m)| m != 0) {
+            for k in (0..3).filter(|k| m >> k & 1 == 1) {
+                boundary.insert(t[k], t[(k + 1) % 3]);
             }
         }
         // Local scale: the mean length of the edges at each boundary vertex.
