@@ -483,7 +483,11 @@ const LEVEL_NEWTON_STEPS: usize = 6;
 ///
 /// On a field that is not a gradient but has one as a multiple, `v = g ∇F` (unit normals),
 /// `∫ v·dp` is not the rise of any potential; with `cfg`'s integrating factor on, the rise is
-/// that of `∫ v·dp / g` ([`Weighed`]) and the end moves by it over `|v(q)|² / g(q)`.
+/// that of `∫ v·dp / g` ([`Weighed`]) and the end moves by it over `|v(q)|² / g(q)`. That
+/// rise is taken along the two halves of a path through the chord's middle moved onto the
+/// surface: a step of 0.1 on a unit-normal ellipsoid ends 1.8·10⁻⁶ off it, against 1.5·10⁻⁵
+/// along the chord itself (whose middle lies where the factor's change across the surface,
+/// which `Weighed` does not know, counts).
 fn on_level<T: Scalar, F: NormalField<T>>(
     field: &F,
     cfg: &StepConfig<T>,
@@ -493,12 +497,23 @@ fn on_level<T: Scalar, F: NormalField<T>>(
 ) -> Vec3<T> {
     if cfg.integrating_factor {
         let d = chord.direction.scale(length);
-        let w = Weighed::along(field, p, &d);
-        let end = &w.values[4];
-        let moved = chord.point.add_scaled(
-            &(-(w.boole() / (end.norm_squared() * w.factors[4].clone()))),
-            end,
-        );
+        let whole = Weighed::along(field, p, &d);
+        // The factor's change across the surface is not in `Weighed`, and the chord's middle
+        // lies off the surface by about κL²/8: the rise is taken along two halves through that
+        // middle moved back onto the surface, each four times nearer to it.
+        let middle = p.add_scaled(&T::from_f64(0.5), &d);
+        let (v2, mu2) = (&whole.values[2], whole.factors[2].clone());
+        let to_middle = whole.first_half();
+        let middle = middle.add_scaled(&(-(to_middle / (v2.norm_squared() * mu2))), v2);
+        let first = Weighed::along(field, p, &(&middle - p));
+        let second = Weighed::along(field, &middle, &(&chord.point - &middle));
+        let mu_middle = first.factors[4].clone();
+        let rise = first.boole() + mu_middle.clone() * second.boole();
+        let end = &second.values[4];
+        let mu_end = mu_middle * second.factors[4].clone();
+        let moved = chord
+            .point
+            .add_scaled(&(-(rise / (end.norm_squared() * mu_end))), end);
         return if moved.is_finite() {
             moved
         } else {
@@ -596,6 +611,12 @@ impl<T: Scalar> Weighed<T> {
             + T::from_f64(32.0) * (f[1].clone() + f[3].clone())
             + T::from_f64(12.0) * f[2].clone())
             / T::from_f64(90.0)
+    }
+
+    /// Simpson's rule for `∫ μ v·dp` over the segment's first half.
+    fn first_half(&self) -> T {
+        let f = &self.rates;
+        (f[0].clone() + T::from_f64(4.0) * f[1].clone() + f[2].clone()) / T::from_f64(12.0)
     }
 
     /// Simpson's rule for `∫ μ v·dp`.
@@ -988,8 +1009,9 @@ mod tests {
                 .fold(0.0, f64::max)
         };
         let (plain, weighed) = (off(false), off(true));
+        // Measured: 1.1e-3 plain, 1.8e-6 weighed (1.5e-5 weighed along the whole chord).
         assert!(
-            weighed < 3e-5 && weighed < plain / 10.0,
+            weighed < 5e-6 && weighed < plain / 200.0,
             "{weighed:e} against {plain:e}"
         );
         // A gradient of one's own has no curl: its correction is the plain one.
