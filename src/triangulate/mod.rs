@@ -749,13 +749,13 @@ fn chart_triangles(chart: &[[f64; 2]], front: &[u32]) -> Result<Vec<[u32; 3]>, M
     // (a tenth of a 10⁵-triangle run's chart triangulation), so large charts are read in
     // chunks side by side, in spade's order all the same.
     let faces = cdt.num_inner_faces();
-    let chunks = if faces >= par::MIN_CHEAP { 16 } else { 1 };
-    if chunks == 1 {
+    if faces < par::MIN_CHEAP {
         return Ok(cdt.inner_faces().filter_map(kept).collect());
     }
+    const CHUNKS: usize = 16;
     let handles: Vec<_> = cdt.fixed_inner_faces().collect();
-    let parts = par::map(chunks, 2, |c| {
-        handles[c * faces / chunks..(c + 1) * faces / chunks]
+    let parts = par::map(CHUNKS, 2, |c| {
+        handles[c * faces / CHUNKS..(c + 1) * faces / CHUNKS]
             .iter()
             .filter_map(|&h| kept(cdt.face(h)))
             .collect::<Vec<_>>()
