@@ -497,7 +497,9 @@ fn on_level<T: Scalar, F: NormalField<T>>(
 ) -> Vec3<T> {
     if cfg.integrating_factor {
         let d = chord.direction.scale(length);
-        let whole = Weighed::along(field, p, &d);
+        // (The field and its curl at `p` serve the whole chord and its first half.)
+        let start = with_curl(field, p);
+        let whole = Weighed::along_from(field, p, start.clone(), &d);
         // The factor's change across the surface is not in `Weighed`, and the chord's middle
         // lies off the surface by about κL²/8: the rise is taken along two halves through that
         // middle moved back onto the surface, each four times nearer to it.
@@ -505,7 +507,7 @@ fn on_level<T: Scalar, F: NormalField<T>>(
         let (v2, mu2) = (&whole.values[2], whole.factors[2].clone());
         let to_middle = whole.first_half();
         let middle = middle.add_scaled(&(-(to_middle / (v2.norm_squared() * mu2))), v2);
-        let first = Weighed::along(field, p, &(&middle - p));
+        let first = Weighed::along_from(field, p, start, &(&middle - p));
         let second = Weighed::along(field, &middle, &(&chord.point - &middle));
         let mu_middle = first.factors[4].clone();
         let rise = first.boole() + mu_middle.clone() * second.boole();
@@ -566,21 +568,38 @@ struct Weighed<T> {
     rates: [T; 5],
 }
 
+/// `v` and its curl at `x`, from the Jacobian (rows ∇vx, ∇vy, ∇vz).
+fn with_curl<T: Scalar, F: NormalField<T>>(field: &F, x: &Vec3<T>) -> (Vec3<T>, Vec3<T>) {
+    let (v, j) = crate::model::value_and_jacobian(field, x);
+    let curl = Vec3::new(
+        j[2].y.clone() - j[1].z.clone(),
+        j[0].z.clone() - j[2].x.clone(),
+        j[1].x.clone() - j[0].y.clone(),
+    );
+    (v, curl)
+}
+
 impl<T: Scalar> Weighed<T> {
     fn along<F: NormalField<T>>(field: &F, p: &Vec3<T>, d: &Vec3<T>) -> Self {
+        Self::along_from(field, p, with_curl(field, p), d)
+    }
+
+    /// [`Weighed::along`] with `v` and its curl at `p` known ([`with_curl`]).
+    fn along_from<F: NormalField<T>>(
+        field: &F,
+        p: &Vec3<T>,
+        (v0, curl0): (Vec3<T>, Vec3<T>),
+        d: &Vec3<T>,
+    ) -> Self {
         let at = |t: f64| p.add_scaled(&T::from_f64(t), d);
-        // v and a·d at a point, from its Jacobian (rows ∇vx, ∇vy, ∇vz).
+        // a·d at a point.
+        let rate = |v: &Vec3<T>, curl: &Vec3<T>| curl.cross(v).dot(d) / v.norm_squared();
         let with_rate = |x: &Vec3<T>| {
-            let (v, j) = crate::model::value_and_jacobian(field, x);
-            let curl = Vec3::new(
-                j[2].y.clone() - j[1].z.clone(),
-                j[0].z.clone() - j[2].x.clone(),
-                j[1].x.clone() - j[0].y.clone(),
-            );
-            let rate = curl.cross(&v).dot(d) / v.norm_squared();
-            (v, rate)
+            let (v, curl) = with_curl(field, x);
+            let a = rate(&v, &curl);
+            (v, a)
         };
-        let (v0, a0) = with_rate(p);
+        let a0 = rate(&v0, &curl0);
         let (v2, a2) = with_rate(&at(0.5));
         let (v4, a4) = with_rate(&at(1.0));
         let (v1, v3) = (field.normal(&at(0.25)), field.normal(&at(0.75)));

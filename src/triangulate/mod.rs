@@ -450,22 +450,21 @@ fn bridges(normals: &[[f64; 3]], t: [u32; 3], limit_cos: f64) -> bool {
 /// ([`BRIDGE_DEG`]), and every triangle that shares a corner with one.
 fn drop_folds(pos: &[[f64; 3]], normals: &[[f64; 3]], triangles: &mut Vec<[u32; 3]>) {
     let limit = FOLD_DEG.to_radians().cos();
-    let mut bad = vec![false; pos.len()];
-    let mut any = false;
     let spread_limit = BRIDGE_DEG.to_radians().cos();
     let folds = par::map(triangles.len(), par::MIN_CHEAP, |i| {
         let t = triangles[i];
         flip::agreement(pos, normals, t) < limit || bridges(normals, t, spread_limit)
     });
+    if !folds.contains(&true) {
+        return;
+    }
+    let mut bad = vec![false; pos.len()];
     for (&t, _) in triangles.iter().zip(&folds).filter(|(_, &f)| f) {
-        any = true;
         for v in t {
             bad[v as usize] = true;
         }
     }
-    if any {
-        triangles.retain(|t| !t.iter().any(|&v| bad[v as usize]));
-    }
+    triangles.retain(|t| !t.iter().any(|&v| bad[v as usize]));
 }
 
 /// A chart triangle is kept only if no edge is longer in space than this many times the
