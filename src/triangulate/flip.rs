@@ -65,6 +65,30 @@ pub(super) fn agreement_at(corners: [[f64; 3]; 3], n: &[[f64; 3]], t: [u32; 3]) 
     cosine(cross(sub(b, a), sub(c, a)), field_normal(n, t))
 }
 
+/// [`agreement_at`] where it is below `floor` (a positive cosine), and `floor` itself where the
+/// agreement is certainly at least `floor`: decided from `f·g` and `|f|²|g|²` without a square
+/// root or a division where those are normal numbers, with a relative margin of 10⁻¹² that
+/// covers their rounding. `min(floor, x)` and `x < min(floor, y)` come out as with the exact
+/// agreements (the relaxation asks this of every face in every sweep).
+pub(super) fn agreement_below(
+    corners: [[f64; 3]; 3],
+    n: &[[f64; 3]],
+    t: [u32; 3],
+    floor: f64,
+) -> f64 {
+    let [a, b, c] = corners;
+    let (f, g) = (cross(sub(b, a), sub(c, a)), field_normal(n, t));
+    let (fg, dd) = (dot(f, g), dot(f, f) * dot(g, g));
+    if fg > 1e-140
+        && fg < 1e140
+        && (1e-280..=1e280).contains(&dd)
+        && fg * fg >= floor * floor * (1.0 + 1e-12) * dd
+    {
+        return floor;
+    }
+    cosine(f, g)
+}
+
 /// Cosine of the angle between face normal `f` and field normal `g`; −1 when either vanishes.
 fn cosine(f: [f64; 3], g: [f64; 3]) -> f64 {
     let d = (dot(f, f) * dot(g, g)).sqrt();
@@ -909,6 +933,57 @@ mod tests {
             );
         }
         assert!((1_000..29_000).contains(&within), "{within}");
+    }
+
+    #[test]
+    fn agreement_below_a_floor_is_exact_there_and_the_floor_above() {
+        let mut rng = crate::geom::rng::XorShift64::new(31);
+        let floor = 0.5;
+        let (mut above, mut exact) = (0, 0);
+        for k in 0..30_000 {
+            let range = if k % 2 == 0 { 3.0 } else { 200.0 };
+            let scale = 10f64.powf(rng.uniform(-range, range));
+            let p: Vec<[f64; 3]> = (0..3).map(|_| rng.in_cube(scale)).collect();
+            let f = face_normal(&p, [0, 1, 2]);
+            // Every corner's normal at 60° from the face for a quarter of the faces (the
+            // agreement then lies at the floor to rounding), near it for another quarter.
+            let unit = |v: [f64; 3]| v.map(|x| x / dot(v, v).sqrt());
+            let (fu, side) = (unit(f), unit(cross(f, rng.in_cube(1.0))));
+            let n: Vec<[f64; 3]> = (0..3)
+                .map(|_| {
+                    let u = match k % 4 {
+                        0 => {
+                            let s = 0.75f64.sqrt();
+                            [0, 1, 2].map(|i| 0.5 * fu[i] + s * side[i])
+                        }
+                        1 => {
+                            let r = rng.in_cube(1.0);
+                            [0, 1, 2].map(|i| fu[i] + r[i])
+                        }
+                        _ => rng.in_cube(1.0),
+                    };
+                    u.map(|x| x * 10f64.powf(rng.uniform(-range, range)))
+                })
+                .collect();
+            let t = [0, 1, 2];
+            let cos = agreement(&p, &n, t);
+            let got = agreement_below([p[0], p[1], p[2]], &n, t, floor);
+            if cos < floor {
+                exact += 1;
+                assert_eq!(got.to_bits(), cos.to_bits(), "{p:?} {n:?}");
+            } else {
+                above += 1;
+                assert!(
+                    got == floor || got.to_bits() == cos.to_bits(),
+                    "{p:?} {n:?}"
+                );
+            }
+            // What the relaxation asks of it, against any earlier agreement.
+            let b = rng.uniform(-1.0, 1.0);
+            assert_eq!(got < floor.min(b), cos < floor.min(b));
+            assert_eq!(floor.min(got), floor.min(cos));
+        }
+        assert!(exact > 5_000 && above > 5_000, "{exact} {above}");
     }
 
     /// A flat rhombus in the plane z = 0 whose diagonal 0–2 is the long one.

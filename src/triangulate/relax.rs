@@ -6,7 +6,7 @@
 //! derivatives, and MPFR runs stay comparable with `f64` ones. `p0` and boundary vertices stay
 //! where they are. Edge flips afterwards restore the surface Delaunay property.
 
-use super::flip::{agreement_at, flip_to_surface_delaunay};
+use super::flip::{agreement_below, flip_to_surface_delaunay};
 use super::Mesh;
 use crate::geom::rows::rows_by_corner;
 use crate::par;
@@ -153,7 +153,8 @@ pub(super) const MIN_AGREEMENT: f64 = 0.5;
 /// Accepts the sweep's moves except where a triangle would fold: the vertices of every
 /// triangle whose face normal turns away from the field normal (and did not before) go back
 /// to where they were, until no such triangle is left. `before` holds each face's agreement
-/// at `old` if known; returns the positions and each face's agreement at them.
+/// at `old` if known; returns the positions and each face's agreement at them (agreements
+/// above [`MIN_AGREEMENT`] given as that).
 fn keep_orientation<T: Scalar>(
     triangles: &[[u32; 3]],
     normals: &[[f64; 3]],
@@ -161,8 +162,15 @@ fn keep_orientation<T: Scalar>(
     mut new: Vec<Vec3<T>>,
     before: Option<Vec<f64>>,
 ) -> (Vec<Vec3<T>>, Vec<f64>) {
+    // Only agreements below `MIN_AGREEMENT` matter (each face is held to the lower of that
+    // and where it was), so those above are not computed exactly.
     let agreement = |pos: &[Vec3<T>], t: &[u32; 3]| {
-        agreement_at(t.map(|i| pos[i as usize].to_f64()), normals, *t)
+        agreement_below(
+            t.map(|i| pos[i as usize].to_f64()),
+            normals,
+            *t,
+            MIN_AGREEMENT,
+        )
     };
     // Positions are read through `to_f64` rather than copied: free for `f64`, and no second
     // copy of the mesh at the pipeline's peak memory.
