@@ -2027,21 +2027,35 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
             return 0;
         }
         let mut added = 0;
-        for attempt in 0..=CHART_ATTEMPTS {
-            let mut failed = Vec::new();
+        let mut attempt = 0;
+        // Each pass either fills a hole (a finite number of them), or opens the failed ones
+        // (at most `CHART_ATTEMPTS` times): the bound is never reached, only a guard.
+        for _ in 0..CHART_HOLE {
+            let (mut failed, mut filled) = (Vec::new(), false);
             for ring in self.open_loops(CHART_HOLE) {
                 match self.fill_by_chart(&ring, Patch::Refined, 0.0) {
                     Some((triangles, vertices)) => {
                         added += triangles;
                         out.vertices += vertices;
+                        filled = true;
                     }
                     None => failed.push(ring),
                 }
             }
-            if failed.is_empty() || attempt == CHART_ATTEMPTS {
+            // A hole touching another at a vertex may not be walked round as a loop while
+            // the other is open (the walk turns into the other there); once that one is
+            // filled it is, so the loops are listed again.
+            if failed.is_empty() {
+                if filled {
+                    continue;
+                }
                 break;
             }
-            let (removed, _) = self.open_around(&failed, attempt + 1);
+            if attempt == CHART_ATTEMPTS {
+                break;
+            }
+            attempt += 1;
+            let (removed, _) = self.open_around(&failed, attempt);
             out.removed += removed.len();
         }
         added
@@ -2082,16 +2096,25 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
                 ring.push(edges[i].0);
                 e = next[i];
             }
-            if !closed || ring.len() < 3 || ring.len() > limit {
+            if !closed {
                 continue;
             }
+            // A walk through a vertex twice is two holes touching there that the turn at the
+            // vertex did not tell apart: each is a loop of its own.
             let mut distinct = ring.clone();
             distinct.sort_unstable();
             distinct.dedup();
-            if distinct.len() == ring.len()
-                && ring.iter().all(|&v| self.rim[v as usize] == Rim::Open)
-            {
-                out.push(ring);
+            let rings = if distinct.len() == ring.len() {
+                vec![ring]
+            } else {
+                simple_loops(&ring)
+            };
+            for ring in rings {
+                if (3..=limit).contains(&ring.len())
+                    && ring.iter().all(|&v| self.rim[v as usize] == Rim::Open)
+                {
+                    out.push(ring);
+                }
             }
         }
         out
@@ -2753,6 +2776,28 @@ fn tangent_frame(n: [f64; 3]) -> ([f64; 3], [f64; 3]) {
     (e1, cross(n, e1))
 }
 
+/// A closed walk split into loops that pass each vertex once: wherever the walk comes back
+/// to a vertex, the part since its last visit is a loop of its own. The loops' edges are the
+/// walk's, each once; loops of fewer than three vertices (an edge there and back) are left
+/// out.
+fn simple_loops(walk: &[u32]) -> Vec<Vec<u32>> {
+    let mut loops = Vec::new();
+    let mut path: Vec<u32> = Vec::with_capacity(walk.len());
+    for &v in walk {
+        if let Some(k) = path.iter().position(|&u| u == v) {
+            let tail = path.split_off(k);
+            if tail.len() >= 3 {
+                loops.push(tail);
+            }
+        }
+        path.push(v);
+    }
+    if path.len() >= 3 {
+        loops.push(path);
+    }
+    loops
+}
+
 /// Whether the closed polygon `p` is simple: no two edges meet but neighbours at their
 /// shared corner (floating-point orientation tests with a margin, erring on "not simple").
 fn simple_polygon(p: &[[f64; 2]]) -> bool {
@@ -2959,4 +3004,38 @@ fn pinched_fans(triangles: &[[u32; 3]], candidate: impl Fn(u32) -> bool) -> (Vec
     drop.sort_unstable();
     drop.dedup();
     (pinched, drop)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::simple_loops;
+
+    #[test]
+    fn a_walk_through_a_vertex_twice_is_two_loops_each_edge_once() {
+        // A 13-edge hole and a 3-edge one touching at vertex 5, walked as one.
+        let walk = [1, 2, 3, 4, 5, 20, 21, 5, 6, 7, 8, 9];
+        let loops = simple_loops(&walk);
+        assert_eq!(
+            loops,
+            vec![vec![5, 20, 21], vec![1, 2, 3, 4, 5, 6, 7, 8, 9]]
+        );
+        let edges = |ring: &[u32]| {
+            let m = ring.len();
+            (0..m)
+                .map(move |i| (ring[i], ring[(i + 1) % m]))
+                .collect::<Vec<_>>()
+        };
+        let mut all: Vec<_> = loops.iter().flat_map(|l| edges(l)).collect();
+        let mut want = edges(&walk);
+        all.sort_unstable();
+        want.sort_unstable();
+        assert_eq!(all, want);
+        // Nested returns, and an edge there and back (a two-vertex loop) left out.
+        assert_eq!(
+            simple_loops(&[1, 2, 3, 4, 2, 5, 6, 5, 7]),
+            vec![vec![2, 3, 4], vec![1, 2, 5, 7]]
+        );
+        // A simple loop is itself.
+        assert_eq!(simple_loops(&[3, 1, 2]), vec![vec![3, 1, 2]]);
+    }
 }
