@@ -79,14 +79,17 @@ pub(super) fn agreement_below(
     let [a, b, c] = corners;
     let (f, g) = (cross(sub(b, a), sub(c, a)), field_normal(n, t));
     let (fg, dd) = (dot(f, g), dot(f, f) * dot(g, g));
-    if fg > 1e-140
-        && fg < 1e140
-        && (1e-280..=1e280).contains(&dd)
-        && fg * fg >= floor * floor * (1.0 + 1e-12) * dd
-    {
+    if squares_comparable(fg, dd) && fg * fg >= floor * floor * (1.0 + 1e-12) * dd {
         return floor;
     }
     cosine(f, g)
+}
+
+/// Whether a positive `f·g` and `|f|²|g|²` are normal numbers far enough from underflow and
+/// overflow that `(f·g)²` against a cosine's square times `|f|²|g|²` decides the cosine.
+#[inline]
+fn squares_comparable(fg: f64, dd: f64) -> bool {
+    fg > 1e-140 && fg < 1e140 && (1e-280..=1e280).contains(&dd)
 }
 
 /// Cosine of the angle between face normal `f` and field normal `g`; −1 when either vanishes.
@@ -124,7 +127,7 @@ pub(crate) fn against_field(p: &[[f64; 3]], n: &[[f64; 3]], t: [u32; 3]) -> bool
 fn within_tilt(p: &[[f64; 3]], n: &[[f64; 3]], t: [u32; 3], cos_limit: f64) -> bool {
     let (f, g) = (face_normal(p, t), field_normal(n, t));
     let (fg, dd) = (dot(f, g), dot(f, f) * dot(g, g));
-    if fg > 1e-140 && fg < 1e140 && (1e-280..=1e280).contains(&dd) {
+    if squares_comparable(fg, dd) {
         return fg * fg >= cos_limit * cos_limit * dd;
     }
     agreement(p, n, t) >= cos_limit

@@ -2101,15 +2101,7 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
             }
             // A walk through a vertex twice is two holes touching there that the turn at the
             // vertex did not tell apart: each is a loop of its own.
-            let mut distinct = ring.clone();
-            distinct.sort_unstable();
-            distinct.dedup();
-            let rings = if distinct.len() == ring.len() {
-                vec![ring]
-            } else {
-                simple_loops(&ring)
-            };
-            for ring in rings {
+            for ring in simple_loops(&ring) {
                 if (3..=limit).contains(&ring.len())
                     && ring.iter().all(|&v| self.rim[v as usize] == Rim::Open)
                 {
@@ -2783,13 +2775,19 @@ fn tangent_frame(n: [f64; 3]) -> ([f64; 3], [f64; 3]) {
 fn simple_loops(walk: &[u32]) -> Vec<Vec<u32>> {
     let mut loops = Vec::new();
     let mut path: Vec<u32> = Vec::with_capacity(walk.len());
+    // Where each vertex on the path is (a far cap's loop has hundreds of vertices).
+    let mut at: HashMap<u32, usize, FastHash> = HashMap::default();
     for &v in walk {
-        if let Some(k) = path.iter().position(|&u| u == v) {
+        if let Some(&k) = at.get(&v) {
             let tail = path.split_off(k);
+            for u in &tail {
+                at.remove(u);
+            }
             if tail.len() >= 3 {
                 loops.push(tail);
             }
         }
+        at.insert(v, path.len());
         path.push(v);
     }
     if path.len() >= 3 {
