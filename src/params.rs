@@ -176,7 +176,10 @@ pub struct MeshParams {
     pub max_retries: usize,
     /// Refinement: split faces whose normal error (the angle between the face and the field
     /// normal at its centroid) exceeds this, after the mesh is built. `None` leaves the mesh
-    /// as built.
+    /// as built. Only faces whose corners lie on one surface can meet a bound below the
+    /// field's own tilt across them: in the paper's mode (whose chords drift off the level
+    /// set) and on a non-integrable field the refinement stops when it stalls
+    /// ([`Refinement::stalled`](crate::triangulate::Refinement::stalled)).
     #[cfg_attr(
         feature = "serde",
         serde(

@@ -1260,3 +1260,78 @@ fn a_cylinders_seam_follows_the_surface() {
     let (worst, _) = liemesh::quality::face_normal_error(&field, &run.mesh);
     assert!(worst < 30.0, "a face {worst:.1}° off the surface");
 }
+
+/// Found by a sweep of a new user's options: an elliptic cylinder meshed with `close =
+/// false` (curves not stopped where they meet) came out as 2 of 149,118 faces, the rest cut
+/// out as crossing, and the run said nothing was cut short. It says so now; with the
+/// defaults the same start gives the band.
+#[test]
+fn a_run_whose_crossings_took_most_of_the_mesh_says_it_was_cut_short() {
+    let cylinder =
+        Invariant::from_numbers(&[0.0, 0.9344729370011364, 1.8130420891464543, 0.0, 0.0, 0.0])
+            .unwrap();
+    let field = LieField::<f64>::new(&cylinder);
+    let mut params = MeshParams::at([
+        -1.4589306353849012,
+        -0.022956435518164602,
+        0.7424874085347022,
+    ]);
+    let band = liemesh::run(&field, &params).unwrap();
+    assert!(band.cut_short().is_empty(), "{:?}", band.cut_short());
+    assert_eq!(
+        (
+            band.validation.euler_characteristic,
+            band.validation.boundary_loops
+        ),
+        (0, 2)
+    );
+    params.close = false;
+    let run = liemesh::run(&field, &params).unwrap();
+    assert!(run.validation.is_valid());
+    assert!(run.untangled.removed > run.mesh.triangles.len());
+    let why = run.cut_short().join("; ");
+    assert!(
+        why.contains("crossed others") && why.contains("without close"),
+        "{why}"
+    );
+}
+
+/// Found by a sweep of a new user's options: refinement to a normal-error bound where the
+/// mesh's corners are not on one surface (the paper's mode, whose chords drift off the
+/// sphere; fig6's non-integrable field) only tilted smaller faces more, and ran on to the
+/// point budget: 4 million triangles in 45 s. It stops when it stalls and says so; where the
+/// corners are on the surface it still meets the bound.
+#[test]
+fn a_refinement_that_cannot_converge_stops_and_says_so() {
+    let sphere = Invariant::from_numbers(&[1.0, 1.0, 1.0, 0.0, 0.0, 0.0]).unwrap();
+    let sphere = LieField::<f64>::new(&sphere);
+    let mut paper = MeshParams::at([1.0, 0.0, 0.0]);
+    paper.mode = Mode::Paper;
+    paper.max_normal_error = Some(Angle::from_degrees(5.0));
+    let mut fig6 = Preset::Fig6.params();
+    fig6.max_normal_error = Some(Angle::from_degrees(2.0));
+    for (field, params) in [
+        (&sphere, &paper),
+        (&LieField::new(&Preset::Fig6.invariant()), &fig6),
+    ] {
+        let run = liemesh::run(field, params).unwrap();
+        let refinement = run.refinement.unwrap();
+        assert!(
+            refinement.stalled && refinement.over_limit > 0,
+            "{refinement:?}"
+        );
+        assert!(
+            run.mesh.triangles.len() < 100_000,
+            "{}",
+            run.mesh.triangles.len()
+        );
+        assert!(run.cut_short().join("; ").contains("stalled"));
+    }
+    let mut fine = MeshParams::at([1.0, 0.0, 0.0]);
+    fine.max_normal_error = Some(Angle::from_degrees(0.5));
+    let refinement = liemesh::run(&sphere, &fine).unwrap().refinement.unwrap();
+    assert!(
+        !refinement.stalled && refinement.over_limit == 0,
+        "{refinement:?}"
+    );
+}

@@ -173,7 +173,9 @@ pub struct Overrides {
     #[arg(long, allow_hyphen_values = true, value_parser = parse_finite)]
     #[serde(skip_serializing_if = "Option::is_none")]
     pub bounding_box: Option<f64>,
-    /// Do not stop curves where fronts meet nor stitch them (`close = false`).
+    /// Do not stop curves where fronts meet nor stitch them (`close = false`); on a surface
+    /// the curves go round, they then run over one another, and the faces that cross are
+    /// cut out.
     #[arg(long)]
     #[serde(skip)]
     pub no_close: bool,
@@ -641,6 +643,13 @@ fn print_summary(r: &Report, mesh: Option<&Path>, report: Option<&Path>) {
             if f.rounds == 1 { "" } else { "s" },
             if f.over_limit == 0 {
                 format!("every face within {limit}° of the field normal")
+            } else if f.stalled {
+                format!(
+                    "{} faces still over {limit}° (the rounds stopped making progress: smaller \
+                     faces only tilted more, their corners not on one surface, which the \
+                     paper's chords drift off and a non-integrable field does not have)",
+                    f.over_limit
+                )
             } else {
                 format!(
                     "{} faces still over {limit}° (the rounds or the point budget ran out, or \

@@ -76,7 +76,8 @@ pub struct Report {
     /// How many curves ended for each reason.
     #[cfg_attr(feature = "serde", serde(default))]
     pub curve_ends: crate::sample::CurveEnds,
-    /// The budgets that cut the run short, in words; empty for a complete run.
+    /// What cut the run short, in words ([`crate::MeshRun::cut_short`]); empty for a
+    /// complete run.
     #[cfg_attr(feature = "serde", serde(default))]
     pub cut_short: Vec<String>,
     /// What stitching where fronts met did.

@@ -67,7 +67,8 @@ fn coarse(c: Cell, level: u32) -> Cell {
     shifted(c, LEVEL_BITS * level)
 }
 
-/// A level's rows by coarse cell, each with its own cell (see [`Level::coarse`]).
+/// A level's rows (or a [`PointGrid`]'s cells) by coarse cell, each with its own cell (see
+/// [`Level::coarse`]).
 type CoarseIndex = HashMap<Cell, Vec<(Cell, u32)>, FastHash>;
 
 /// The triangles filed at one level.
@@ -332,7 +333,7 @@ pub(super) struct PointGrid {
     /// date. Where the stitched edges are far longer than the grid's cells (an elliptic
     /// cylinder 10:1 met from its flat side: edges of `dt_max` beside ones a hundredth of
     /// that) a query looked up, or scanned, tens of thousands of cells: 40% of a 37 s run.
-    coarse: [OnceCell<HashMap<Cell, Vec<(Cell, u32)>, FastHash>>; POINT_COARSE_INDEXES],
+    coarse: [OnceCell<CoarseIndex>; POINT_COARSE_INDEXES],
 }
 
 /// How many coarse indexes a [`PointGrid`] may make: up to cells `4^8 = 65,536` of its own
@@ -434,7 +435,7 @@ impl PointGrid {
             return;
         };
         let index = self.coarse[d].get_or_init(|| {
-            let mut index: HashMap<Cell, Vec<(Cell, u32)>, FastHash> = HashMap::default();
+            let mut index = CoarseIndex::default();
             for (i, (c, _)) in self.cells.iter().enumerate() {
                 index
                     .entry(Self::coarse_of(*c, d))
