@@ -71,6 +71,47 @@ fn coarse(c: Cell, level: u32) -> Cell {
 /// [`Level::coarse`]).
 type CoarseIndex = HashMap<Cell, Vec<(Cell, u32)>, FastHash>;
 
+/// The coarse index of `cells` (each a cell and its row or index), by the coarse cell
+/// `to_coarse` puts each in.
+fn coarse_index(
+    cells: impl Iterator<Item = (Cell, u32)>,
+    to_coarse: impl Fn(Cell) -> Cell,
+) -> CoarseIndex {
+    let mut index = CoarseIndex::default();
+    for (cell, id) in cells {
+        index.entry(to_coarse(cell)).or_default().push((cell, id));
+    }
+    index
+}
+
+/// Calls `f` with the row or index of every entry of `index` whose own cell lies in the box
+/// of cells from `lo` to `hi`, looking up the coarse cells (`to_coarse`) the box meets.
+fn walk_coarse(
+    index: &CoarseIndex,
+    lo: Cell,
+    hi: Cell,
+    to_coarse: impl Fn(Cell) -> Cell,
+    mut f: impl FnMut(u32),
+) {
+    let (clo, chi) = (to_coarse(lo), to_coarse(hi));
+    for x in clo.0..=chi.0 {
+        for y in clo.1..=chi.1 {
+            for z in clo.2..=chi.2 {
+                for &(c, id) in index.get(&(x, y, z)).into_iter().flatten() {
+                    if in_box(c, lo, hi) {
+                        f(id);
+                    }
+                }
+            }
+        }
+    }
+}
+
+/// Whether cell `c` lies in the box of cells from `lo` to `hi`.
+fn in_box(c: Cell, lo: Cell, hi: Cell) -> bool {
+    (lo.0..=hi.0).contains(&c.0) && (lo.1..=hi.1).contains(&c.1) && (lo.2..=hi.2).contains(&c.2)
+}
+
 /// The triangles filed at one level.
 ///
 /// The triangles given at construction are filed once, in compressed rows by cell (no list
@@ -122,33 +163,10 @@ impl Level {
                 self.later.iter().flatten().for_each(|&t| f(t));
                 return;
             };
-            let (clo, chi) = (coarse_cell(lo, depth), coarse_cell(hi, depth));
-            let coarse = self.coarse[depth as usize - 1].get_or_init(|| {
-                let mut coarse = CoarseIndex::default();
-                for (&cell, &r) in &self.rows {
-                    coarse
-                        .entry(coarse_cell(cell, depth))
-                        .or_default()
-                        .push((cell, r));
-                }
-                coarse
-            });
-            let inside = |c: Cell| {
-                (lo.0..=hi.0).contains(&c.0)
-                    && (lo.1..=hi.1).contains(&c.1)
-                    && (lo.2..=hi.2).contains(&c.2)
-            };
-            for x in clo.0..=chi.0 {
-                for y in clo.1..=chi.1 {
-                    for z in clo.2..=chi.2 {
-                        for &(cell, r) in coarse.get(&(x, y, z)).into_iter().flatten() {
-                            if inside(cell) {
-                                self.row(r, f);
-                            }
-                        }
-                    }
-                }
-            }
+            let to_coarse = |c: Cell| coarse_cell(c, depth);
+            let coarse = self.coarse[depth as usize - 1]
+                .get_or_init(|| coarse_index(self.rows.iter().map(|(&c, &r)| (c, r)), to_coarse));
+            walk_coarse(coarse, lo, hi, to_coarse, |r| self.row(r, f));
             return;
         }
         for x in lo.0..=hi.0 {
@@ -416,45 +434,27 @@ impl PointGrid {
             }
             return;
         }
-        let inside = |c: Cell| {
-            (lo.0..=hi.0).contains(&c.0)
-                && (lo.1..=hi.1).contains(&c.1)
-                && (lo.2..=hi.2).contains(&c.2)
-        };
         // A scan of the cells costs about a lookup per ten cells.
         let coarse = (0..POINT_COARSE_INDEXES)
-            .map(|d| (d, Self::coarse_of(lo, d), Self::coarse_of(hi, d)))
-            .find(|&(_, clo, chi)| cell_count(clo, chi) <= MAX_COARSE_CELLS_PER_POINT_QUERY)
+            .find(|&d| {
+                cell_count(Self::coarse_of(lo, d), Self::coarse_of(hi, d))
+                    <= MAX_COARSE_CELLS_PER_POINT_QUERY
+            })
             .filter(|_| self.cells.len() as i64 > 10 * MAX_COARSE_CELLS_PER_POINT_QUERY);
-        let Some((d, clo, chi)) = coarse else {
+        let Some(d) = coarse else {
             for (i, (c, _)) in self.cells.iter().enumerate() {
-                if inside(*c) {
+                if in_box(*c, lo, hi) {
                     visit(i as u32);
                 }
             }
             return;
         };
+        let to_coarse = |c: Cell| Self::coarse_of(c, d);
         let index = self.coarse[d].get_or_init(|| {
-            let mut index = CoarseIndex::default();
-            for (i, (c, _)) in self.cells.iter().enumerate() {
-                index
-                    .entry(Self::coarse_of(*c, d))
-                    .or_default()
-                    .push((*c, i as u32));
-            }
-            index
+            let cells = self.cells.iter().enumerate();
+            coarse_index(cells.map(|(i, (c, _))| (*c, i as u32)), to_coarse)
         });
-        for x in clo.0..=chi.0 {
-            for y in clo.1..=chi.1 {
-                for z in clo.2..=chi.2 {
-                    for &(c, i) in index.get(&(x, y, z)).into_iter().flatten() {
-                        if inside(c) {
-                            visit(i);
-                        }
-                    }
-                }
-            }
-        }
+        walk_coarse(index, lo, hi, to_coarse, visit);
     }
 }
 

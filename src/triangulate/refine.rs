@@ -33,18 +33,18 @@ pub const MAX_REFINE_ROUNDS: usize = 64;
 /// Most faces on one longest-edge propagation path.
 const MAX_PATH: usize = 64;
 
-/// The refinement stops when this many rounds in a row at least doubled the faces and left
-/// those over the bound no fewer and their area no smaller ([`Refinement::stalled`]).
-/// Splits shrink the error of a face only where its corners lie on one surface: the paper's
-/// mode leaves its vertices up to 4% off the unit sphere, and there each split made steeper
-/// faces between a new vertex and a drifted one; asked for 5°, the rounds went on to the
-/// point budget, 4 million triangles in 45 s, with more area over the bound than at the
-/// start (it stops at 17,694 now). Likewise on a non-integrable field, which has no surface
-/// for the corners to lie on: fig6 asked for 2° went to 2 million vertices (now 6 rounds,
-/// 10,774 vertices). Where the refinement converges, the rounds that double
-/// the faces are the first few, which take the count down; in its tail single rounds raise
-/// the count or the area but add a few percent of faces (the unit sphere to 0.5° in the
-/// default mode: 36 rounds).
+/// The refinement stops when the last this many rounds together at least doubled the faces
+/// and left those over the bound no fewer and their area no smaller
+/// ([`Refinement::stalled`]). Splits shrink the error of a face only where its corners lie
+/// on one surface: the paper's mode leaves its vertices up to 4% off the unit sphere, and
+/// there each split made steeper faces between a new vertex and a drifted one; asked for 5°,
+/// the rounds went on to the point budget, 4 million triangles in 45 s, with more area over
+/// the bound than at the start (it stops at 17,694 now). Likewise on a non-integrable field,
+/// which has no surface for the corners to lie on: fig6 asked for 2° went to 2 million
+/// vertices (now 6 rounds, 10,774 vertices). Where the refinement converges, the rounds that
+/// double the faces are the first few, which take the count down; in its tail single rounds
+/// raise the count or the area but add a few percent of faces (the unit sphere to 0.5° in
+/// the default mode: 36 rounds).
 const STALL_ROUNDS: usize = 4;
 
 /// What a refinement to `MeshParams::max_normal_error` did ([`crate::MeshRun::refinement`]).
@@ -73,8 +73,8 @@ pub struct Refinement {
     /// budget or the surface (a chord that finds no root, a split that would fold a face)
     /// stopped the refinement, or it stalled.
     pub over_limit: usize,
-    /// Whether the refinement stopped because four rounds in a row doubled the
-    /// faces and left those over the bound no fewer and their area no smaller: the mesh's
+    /// Whether the refinement stopped because its last four rounds together at least doubled
+    /// the faces and left those over the bound no fewer and their area no smaller: the mesh's
     /// vertices are not on one surface (the paper's mode, whose chords drift off their level
     /// set, or a non-integrable field, which has none), so that smaller faces only tilt more.
     #[cfg_attr(feature = "serde", serde(default))]
@@ -250,6 +250,7 @@ pub(crate) fn refine<T: Scalar, F: NormalField<T>>(
             area_over(vertices, he.triangles(), &errors, limit_deg),
             he.triangles().len(),
         );
+        // The state STALL_ROUNDS rounds ago (the start, before that many rounds).
         let before = progress[progress.len().saturating_sub(STALL_ROUNDS)];
         progress.push(now);
         let (fewer, smaller, doubled) = (now.0 < before.0, now.1 < before.1, now.2 >= 2 * before.2);
