@@ -127,7 +127,8 @@ pub struct MeshParams {
     /// step scales when that is smaller.
     pub dt: Option<f64>,
     /// Smallest step (steps are clamped to `[dt_min, dt_max]`); automatic: 10⁻³ step scales,
-    /// or a quarter of `beta_min` (in radians) step scales when that is smaller; on an
+    /// or a quarter of `beta_min` (in radians) step scales when that is smaller (but a
+    /// five-hundredth of a given `dt_max` when that value is above it); on an
     /// ellipsoid up to 16:1 ([`NormalField::semi_axes_through`]) also at most a quarter of
     /// `beta_min` times its sharpest bend's radius. On a non-integrable field, whose sheet may
     /// run into a singular point of the field, up to 10⁻² step scales but at most 4·10⁻³
@@ -526,11 +527,13 @@ impl MeshParams {
                 )
             };
             // (Only a surface hundreds of times flatter at `p0` than its extent has the
-            // automatic dt_min above that bound.)
-            if self.dt_max.is_none() {
-                auto.min(dt_max)
-            } else {
-                auto
+            // automatic dt_min above that bound.) A dt_max given below it, as the error of a
+            // run whose steps were too long advises, takes dt_min down with it, in the
+            // proportion of the automatic clamps.
+            match self.dt_max {
+                None => auto.min(dt_max),
+                Some(given) if auto > given => given * (AUTO_DT_MIN / AUTO_DT_MAX),
+                Some(_) => auto,
             }
         });
         let resolved = Resolved {

@@ -466,6 +466,38 @@ fn no_surviving_triangle_is_explained_for_level_sets_and_swept_surfaces_apart() 
     assert!(swept.to_string().contains("folds onto itself"), "{swept}");
 }
 
+/// Found by a sweep of a new user's inputs (thirty-fifth session): a 42:1 flattened ellipsoid
+/// from near its flat face failed with no surviving triangle and advised shorter steps, but
+/// any `dt_max` given below the automatic `dt_min` (25 there, sized at the nearly flat
+/// `p0`) was refused as "below dt_min", which the user had not given. The automatic `dt_min`
+/// now follows a `dt_max` given below it, in the automatic clamps' proportion (1 : 500); one
+/// given above it changes nothing.
+#[test]
+fn a_short_dt_max_takes_the_automatic_dt_min_down_with_it() {
+    let field = sphere();
+    let defaults = MeshParams::at([0.0, 0.0, 1.0])
+        .resolve::<f64, _>(&field)
+        .unwrap();
+    let mut params = MeshParams::at([0.0, 0.0, 1.0]);
+    params.dt_max = Some(0.5 * defaults.dt_min);
+    params.max_radius = Some(0.05);
+    let resolved = params
+        .resolve::<f64, _>(&field)
+        .expect("a short dt_max is taken");
+    assert_eq!(resolved.dt_min, 0.5 * defaults.dt_min / 500.0);
+    let run = liemesh::run(&field, &params).expect("and meshes");
+    fuzz_checks::check_mesh(&run.mesh).unwrap();
+    assert!(
+        run.mesh.triangles.len() > 100,
+        "{}",
+        run.mesh.triangles.len()
+    );
+
+    params.dt_max = Some(2.0 * defaults.dt_min);
+    let resolved = params.resolve::<f64, _>(&field).unwrap();
+    assert_eq!(resolved.dt_min, defaults.dt_min);
+}
+
 /// A 7:1 flattened ellipsoid (`λ` = 1, 1, 50) from its pole and from a generic point, with
 /// defaults: closed, χ = 2. The pole is nearly flat and the rim sharp (radius 0.02), which
 /// the shape at `p0` cannot tell; before the automatic clamps knew the ellipsoid's semi-axes,
