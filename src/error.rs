@@ -122,7 +122,7 @@ pub enum MeshError {
     /// or as part of a component apart from `p0`'s.
     #[error(
         "no triangle of the {points} sample points survived validation ({}); try shorter \
-         steps (dt_max, dt, beta_max) or another p0",
+         steps (dt_max below the {dt_max:.3e} used, dt, beta_max) or another p0",
         if *swept {
             "the swept surface folds onto itself right at p0"
         } else {
@@ -135,6 +135,8 @@ pub enum MeshError {
         points: usize,
         /// Whether the field is not integrable at `p0` (the surface is swept, and may fold).
         swept: bool,
+        /// The largest step the run used (given or automatic).
+        dt_max: f64,
     },
 }
 

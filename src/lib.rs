@@ -429,6 +429,7 @@ pub fn run_observed<T: Scalar, F: NormalField<T>>(
         return Err(MeshError::Empty {
             points: samples.points.len(),
             swept,
+            dt_max: params.dt_max,
         });
     }
     Ok(MeshRun {

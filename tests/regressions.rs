@@ -455,6 +455,9 @@ fn no_surviving_triangle_is_explained_for_level_sets_and_swept_surfaces_apart() 
         message.contains("dt_max") && !message.contains("folds"),
         "{message}"
     );
+    // The message names the dt_max the run used, the one to go below.
+    let used = params.resolve::<f64, _>(&field).unwrap().dt_max;
+    assert!(message.contains(&format!("{used:.3e}")), "{message}");
     params.dt_max = Some(0.1);
     let run = liemesh::run(&field, &params).expect("with shorter steps it meshes");
     fuzz_checks::check_mesh(&run.mesh).unwrap();
@@ -462,7 +465,12 @@ fn no_surviving_triangle_is_explained_for_level_sets_and_swept_surfaces_apart() 
     let swept = MeshError::Empty {
         points: 7,
         swept: true,
+        dt_max: 0.25,
     };
+    assert!(
+        swept.to_string().contains("dt_max below the 2.500e-1 used"),
+        "{swept}"
+    );
     assert!(swept.to_string().contains("folds onto itself"), "{swept}");
 }
 
