@@ -353,13 +353,24 @@ impl MesherInput {
 
 /// Target (a): decodes a [`MesherInput`], runs [`liemesh::run`] in `f64` and checks the result
 /// with [`check_run`]. Invalid invariant numbers must be rejected by
-/// [`Invariant::from_numbers`] exactly when they are not 6, 12 or 18 finite numbers.
+/// [`Invariant::from_numbers`] exactly when they are not 6, 12 or 18 finite numbers with a
+/// non-zero λ (the others are angles: the 4th to 6th of each six, the last three of twelve).
 pub fn mesher(data: &[u8]) -> Result<(), Violation> {
     let Ok(input) = MesherInput::arbitrary_take_rest(Unstructured::new(data)) else {
         return Ok(());
     };
     let numbers = input.numbers();
-    let expected_ok = matches!(numbers.len(), 6 | 12 | 18) && numbers.iter().all(|x| x.is_finite());
+    let is_lambda = |i: usize| {
+        if numbers.len() == 12 {
+            i < 9
+        } else {
+            i % 6 < 3
+        }
+    };
+    let some_lambda = (0..numbers.len()).any(|i| is_lambda(i) && numbers[i] != 0.0);
+    let expected_ok = matches!(numbers.len(), 6 | 12 | 18)
+        && numbers.iter().all(|x| x.is_finite())
+        && some_lambda;
     let invariant = match Invariant::from_numbers(&numbers) {
         Ok(inv) => inv,
         Err(e) => {
@@ -370,7 +381,9 @@ pub fn mesher(data: &[u8]) -> Result<(), Violation> {
             ensure!(
                 matches!(
                     e,
-                    InvariantError::WrongCount(_) | InvariantError::NonFinite { .. }
+                    InvariantError::WrongCount(_)
+                        | InvariantError::NonFinite { .. }
+                        | InvariantError::ZeroField
                 ),
                 "unexpected error {e:?}"
             );

@@ -8,6 +8,7 @@ pub type Mat3<T> = [Vec3<T>; 3];
 
 /// What is wrong with a list of invariant numbers.
 #[derive(Debug, Clone, PartialEq, Error)]
+#[non_exhaustive]
 pub enum InvariantError {
     /// The count is none of 6, 12, 18.
     #[error(
@@ -24,6 +25,13 @@ pub enum InvariantError {
         /// The value found.
         value: f64,
     },
+    /// Every λ is zero: the matrices are zero whatever the angles, and so is the field, at
+    /// every point.
+    #[error(
+        "every λ of the invariant is 0, so its normal field vanishes everywhere and there is \
+         no surface to mesh; give at least one non-zero λ (the angles alone do not make a field)"
+    )]
+    ZeroField,
 }
 
 /// Which Lie algebra an invariant belongs to.
@@ -214,6 +222,9 @@ impl Invariant {
             }
             n => return Err(InvariantError::WrongCount(n)),
         };
+        if rows.iter().all(|row| row[..3].iter().all(|&l| l == 0.0)) {
+            return Err(InvariantError::ZeroField);
+        }
         Ok(Invariant {
             kind,
             rows,
@@ -434,5 +445,38 @@ mod tests {
             Invariant::from_numbers(&n),
             Err(InvariantError::NonFinite { index: 3, .. })
         ));
+    }
+
+    #[test]
+    fn an_invariant_whose_every_lambda_is_zero_is_rejected() {
+        // Found by a sweep of a new user's inputs: `[0, 0, 0, 0, 0, 0]` was taken, and every
+        // p0 then failed as "a singular point, choose another initial point".
+        let zero_lambdas = |n: usize, angle: f64| {
+            // The angles: 4th to 6th of each row of six; the last three of twelve.
+            let mut v = vec![0.0; n];
+            let angles: Vec<usize> = if n == 12 {
+                vec![9, 10, 11]
+            } else {
+                (0..n).filter(|i| i % 6 >= 3).collect()
+            };
+            for i in angles {
+                v[i] = angle;
+            }
+            v
+        };
+        for n in [6, 12, 18] {
+            for angle in [0.0, 0.3] {
+                assert_eq!(
+                    Invariant::from_numbers(&zero_lambdas(n, angle)),
+                    Err(InvariantError::ZeroField),
+                    "{n} numbers"
+                );
+            }
+            // One non-zero λ anywhere makes a field.
+            let mut one = zero_lambdas(n, 0.3);
+            let last_lambda = if n == 12 { 8 } else { n - 4 };
+            one[last_lambda] = -0.5;
+            assert!(Invariant::from_numbers(&one).is_ok(), "{n} numbers");
+        }
     }
 }
