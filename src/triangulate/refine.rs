@@ -20,6 +20,7 @@ use super::flip::{against_field, agreement_at, HalfEdges};
 use super::relax::{towards_centroid, DAMPING, MIN_AGREEMENT};
 use super::{Mesh, Provenance};
 use crate::geom::face_error_deg;
+use crate::geom::vec3::{cross, dot, sub};
 use crate::par;
 use crate::params::Resolved;
 use crate::scalar::{Scalar, Vec3};
@@ -270,8 +271,9 @@ fn area_over(vertices: &[[f64; 3]], triangles: &[[u32; 3]], errors: &[f64], limi
         .zip(errors)
         .filter(|(_, &e)| e > limit_deg)
         .map(|(t, _)| {
-            let [a, b, c] = t.map(|i| Vec3::<f64>::from_f64(vertices[i as usize]));
-            0.5 * (&b - &a).cross(&(&c - &a)).norm()
+            let [a, b, c] = t.map(|i| vertices[i as usize]);
+            let n = cross(sub(b, a), sub(c, a));
+            0.5 * dot(n, n).sqrt()
         })
         .sum()
 }
