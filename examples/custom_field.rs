@@ -6,9 +6,11 @@
 //! the same mesh at 256 bits. Two fields: a torus (genus 1) and an ellipsoid written by hand.
 //!
 //! Run with `cargo run --release --example custom_field` (add `--features mpfr` for the MPFR
-//! rows of the audit).
+//! rows of the audit). With a file name after `--` (`.ply`, `.obj` or `.stl`) it also writes
+//! the torus's mesh there, for `liemesh render` or any mesh viewer.
 
 use liemesh::audit::audit_field;
+use liemesh::io::{write_mesh, WriteOptions};
 use liemesh::model::{FieldFormula, Formula};
 use liemesh::scalar::{Scalar, Vec3};
 use liemesh::{generate, MeshParams};
@@ -60,18 +62,18 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let ellipsoid_params = MeshParams::at([1.0, 0.0, 0.0]);
 
     // A formula runs in every scalar type, so say which one meshes it (`::<f64, _>`).
+    let torus_mesh = generate::<f64, _>(&torus, &torus_params)?;
+    let ellipsoid_mesh = generate::<f64, _>(&ellipsoid, &ellipsoid_params)?;
     for (name, mesh) in [
-        (
-            "torus R = 2, a = 0.75",
-            generate::<f64, _>(&torus, &torus_params)?,
-        ),
-        (
-            "ellipsoid 1 × 1.5 × 2",
-            generate::<f64, _>(&ellipsoid, &ellipsoid_params)?,
-        ),
+        ("torus R = 2, a = 0.75", &torus_mesh),
+        ("ellipsoid 1 × 1.5 × 2", &ellipsoid_mesh),
     ] {
         let v = mesh.validate();
         println!("{name}: {} triangles, {v}", mesh.triangles.len());
+    }
+    if let Some(path) = std::env::args_os().nth(1) {
+        write_mesh(&torus_mesh, path.as_ref(), &WriteOptions::default())?;
+        println!("torus written to {}", path.to_string_lossy());
     }
     // The same formula in single precision.
     let mesh32 = generate::<f32, _>(&torus, &torus_params)?;
