@@ -610,42 +610,54 @@ fn check_samples<T: Scalar>(samples: &Samples<T>) -> Result<(), MeshError> {
 /// that went on, and the region beyond their end belongs to the mesh).
 fn front_polygon<T: Scalar>(samples: &Samples<T>, chart: &[[f64; 2]]) -> Vec<u32> {
     let order = curves_by_theta(samples);
-    let mut poly: Vec<(u32, bool)> = order
+    let poly: Vec<(u32, bool)> = order
         .iter()
         .map(|&c| {
             let curve = &samples.curves[c];
             (*curve.points.last().unwrap(), curve.end == CurveEnd::Merge)
         })
         .collect();
-    // Remove merged ends inside the triangle (origin, previous, next), until none is left.
-    for _ in 0..poly.len() {
-        let m = poly.len();
-        if m <= 3 {
-            break;
+    // Remove merged ends inside the triangle (origin, previous, next), the first in θ order
+    // each time, until none is left (or three ends are). A removal changes the test only for
+    // its two neighbours, so the ends that pass it are kept in an ordered set and the two
+    // are tested again: linear-logarithmic, where scanning the whole polygon per removal was
+    // quadratic (a flattened ellipsoid's 27,847 merged curves: 1.2 s).
+    let m = poly.len();
+    let mut prev: Vec<usize> = (0..m).map(|i| (i + m - 1) % m).collect();
+    let mut next: Vec<usize> = (0..m).map(|i| (i + 1) % m).collect();
+    let inside = |i: usize, prev: &[usize], next: &[usize]| {
+        let (v, merged) = poly[i];
+        merged && {
+            let before = chart[poly[prev[i]].0 as usize];
+            let after = chart[poly[next[i]].0 as usize];
+            let here = chart[v as usize];
+            // Inside the wedge triangle ⇔ on the origin's side of before→after.
+            cross2(sub2(after, before), sub2(here, before)) > 0.0
+                && wedge_span(before, after) < std::f64::consts::PI
         }
-        let mut keep = Vec::with_capacity(m);
-        let mut removed = false;
-        for i in 0..m {
-            let (v, merged) = poly[i];
-            if merged && !removed {
-                let prev = chart[poly[(i + m - 1) % m].0 as usize];
-                let next = chart[poly[(i + 1) % m].0 as usize];
-                let here = chart[v as usize];
-                // Inside the wedge triangle ⇔ on the origin's side of prev→next.
-                if cross2(sub2(next, prev), sub2(here, prev)) > 0.0
-                    && wedge_span(prev, next) < std::f64::consts::PI
-                {
-                    removed = true;
-                    continue;
-                }
+    };
+    let mut alive = vec![true; m];
+    let mut left = m;
+    let mut ready: std::collections::BTreeSet<usize> =
+        (0..m).filter(|&i| inside(i, &prev, &next)).collect();
+    while left > 3 {
+        let Some(i) = ready.pop_first() else {
+            break;
+        };
+        let (p, n) = (prev[i], next[i]);
+        next[p] = n;
+        prev[n] = p;
+        alive[i] = false;
+        left -= 1;
+        for j in [p, n] {
+            if inside(j, &prev, &next) {
+                ready.insert(j);
+            } else {
+                ready.remove(&j);
             }
-            keep.push(poly[i]);
         }
-        if !removed {
-            break;
-        }
-        poly = keep;
     }
+    let poly: Vec<(u32, bool)> = (0..m).filter(|&i| alive[i]).map(|i| poly[i]).collect();
     let mut front: Vec<u32> = poly.into_iter().map(|(v, _)| v).collect();
     front.dedup();
     if front.len() > 1 && front.first() == front.last() {
