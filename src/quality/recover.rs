@@ -89,87 +89,84 @@ pub fn jet_normals(mesh: &Mesh) -> Vec<[f64; 3]> {
         list.sort_unstable();
         list.dedup();
     }
-    let mut ring: Vec<u32> = Vec::new();
-    let mut rows: Vec<[f64; 9]> = Vec::new();
-    let mut rhs: Vec<f64> = Vec::new();
-    (0..n)
-        .map(|i| {
-            let n0 = first[i];
-            if n0 == [0.0; 3] {
-                return n0;
-            }
-            ring.clear();
-            for &j in &neighbours[i] {
-                ring.push(j);
-                ring.extend(&neighbours[j as usize]);
-            }
-            ring.sort_unstable();
-            ring.dedup();
-            ring.retain(|&j| j as usize != i);
-            if ring.len() < 12 {
-                return n0;
-            }
-            // Tangent frame (t1, t2, n0).
-            let helper = if n0[0].abs() < 0.6 {
-                [1.0, 0.0, 0.0]
-            } else {
-                [0.0, 1.0, 0.0]
-            };
-            let t1 = normalize(cross(helper, n0));
-            let t2 = cross(n0, t1);
-            let p = mesh.vertices[i];
-            let local: Vec<[f64; 3]> = ring
-                .iter()
-                .map(|&j| {
-                    let q = mesh.vertices[j as usize];
-                    let d = [q[0] - p[0], q[1] - p[1], q[2] - p[2]];
-                    [dot(d, t1), dot(d, t2), dot(d, n0)]
-                })
-                .collect();
-            // Uniform scaling keeps the slopes and conditions the monomials.
-            let r = local
-                .iter()
-                .map(|d| (d[0] * d[0] + d[1] * d[1]).sqrt())
-                .fold(0.0_f64, f64::max);
-            if r <= 0.0 {
-                return n0;
-            }
-            rows.clear();
-            rhs.clear();
-            for d in &local {
-                let (x, y, z) = (d[0] / r, d[1] / r, d[2] / r);
-                rows.push([
-                    x,
-                    y,
-                    x * x,
-                    x * y,
-                    y * y,
-                    x * x * x,
-                    x * x * y,
-                    x * y * y,
-                    y * y * y,
-                ]);
-                rhs.push(z);
-            }
-            let m = DMatrix::from_fn(rows.len(), 9, |a, b| rows[a][b]);
-            let b = nalgebra::DVector::from_column_slice(&rhs);
-            let svd = m.svd(true, true);
-            // Too few independent directions (points on a curve): keep the first estimate.
-            let smax = svd.singular_values.max();
-            if svd.singular_values.min() <= 1e-8 * smax {
-                return n0;
-            }
-            let Ok(x) = svd.solve(&b, 0.0) else {
-                return n0;
-            };
-            let (a1, a2) = (x[0], x[1]);
-            normalize([
-                n0[0] - a1 * t1[0] - a2 * t2[0],
-                n0[1] - a1 * t1[1] - a2 * t2[1],
-                n0[2] - a1 * t1[2] - a2 * t2[2],
-            ])
-        })
-        .collect()
+    // Each vertex's fit is independent (an SVD of a dozen or more rows): on rayon's pool.
+    crate::par::map(n, crate::par::MIN_COSTLY, |i| {
+        let (mut ring, mut rows, mut rhs) = (Vec::new(), Vec::new(), Vec::new());
+        let n0 = first[i];
+        if n0 == [0.0; 3] {
+            return n0;
+        }
+        ring.clear();
+        for &j in &neighbours[i] {
+            ring.push(j);
+            ring.extend(&neighbours[j as usize]);
+        }
+        ring.sort_unstable();
+        ring.dedup();
+        ring.retain(|&j| j as usize != i);
+        if ring.len() < 12 {
+            return n0;
+        }
+        // Tangent frame (t1, t2, n0).
+        let helper = if n0[0].abs() < 0.6 {
+            [1.0, 0.0, 0.0]
+        } else {
+            [0.0, 1.0, 0.0]
+        };
+        let t1 = normalize(cross(helper, n0));
+        let t2 = cross(n0, t1);
+        let p = mesh.vertices[i];
+        let local: Vec<[f64; 3]> = ring
+            .iter()
+            .map(|&j| {
+                let q = mesh.vertices[j as usize];
+                let d = [q[0] - p[0], q[1] - p[1], q[2] - p[2]];
+                [dot(d, t1), dot(d, t2), dot(d, n0)]
+            })
+            .collect();
+        // Uniform scaling keeps the slopes and conditions the monomials.
+        let r = local
+            .iter()
+            .map(|d| (d[0] * d[0] + d[1] * d[1]).sqrt())
+            .fold(0.0_f64, f64::max);
+        if r <= 0.0 {
+            return n0;
+        }
+        rows.clear();
+        rhs.clear();
+        for d in &local {
+            let (x, y, z) = (d[0] / r, d[1] / r, d[2] / r);
+            rows.push([
+                x,
+                y,
+                x * x,
+                x * y,
+                y * y,
+                x * x * x,
+                x * x * y,
+                x * y * y,
+                y * y * y,
+            ]);
+            rhs.push(z);
+        }
+        let m = DMatrix::from_fn(rows.len(), 9, |a, b| rows[a][b]);
+        let b = nalgebra::DVector::from_column_slice(&rhs);
+        let svd = m.svd(true, true);
+        // Too few independent directions (points on a curve): keep the first estimate.
+        let smax = svd.singular_values.max();
+        if svd.singular_values.min() <= 1e-8 * smax {
+            return n0;
+        }
+        let Ok(x) = svd.solve(&b, 0.0) else {
+            return n0;
+        };
+        let (a1, a2) = (x[0], x[1]);
+        normalize([
+            n0[0] - a1 * t1[0] - a2 * t2[0],
+            n0[1] - a1 * t1[1] - a2 * t2[1],
+            n0[2] - a1 * t1[2] - a2 * t2[2],
+        ])
+    })
 }
 
 /// Fits the field to `mesh`; `hamiltonian` adds the 9 entries of `B`. With a `reference`
