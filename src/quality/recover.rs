@@ -91,12 +91,11 @@ pub fn jet_normals(mesh: &Mesh) -> Vec<[f64; 3]> {
     }
     // Each vertex's fit is independent (an SVD of a dozen or more rows): on rayon's pool.
     crate::par::map(n, crate::par::MIN_COSTLY, |i| {
-        let (mut ring, mut rows, mut rhs) = (Vec::new(), Vec::new(), Vec::new());
         let n0 = first[i];
         if n0 == [0.0; 3] {
             return n0;
         }
-        ring.clear();
+        let mut ring: Vec<u32> = Vec::new();
         for &j in &neighbours[i] {
             ring.push(j);
             ring.extend(&neighbours[j as usize]);
@@ -132,8 +131,7 @@ pub fn jet_normals(mesh: &Mesh) -> Vec<[f64; 3]> {
         if r <= 0.0 {
             return n0;
         }
-        rows.clear();
-        rhs.clear();
+        let (mut rows, mut rhs): (Vec<[f64; 9]>, Vec<f64>) = (Vec::new(), Vec::new());
         for d in &local {
             let (x, y, z) = (d[0] / r, d[1] / r, d[2] / r);
             rows.push([
