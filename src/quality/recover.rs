@@ -131,24 +131,26 @@ pub fn jet_normals(mesh: &Mesh) -> Vec<[f64; 3]> {
         if r <= 0.0 {
             return n0;
         }
-        let (mut rows, mut rhs): (Vec<[f64; 9]>, Vec<f64>) = (Vec::new(), Vec::new());
-        for d in &local {
-            let (x, y, z) = (d[0] / r, d[1] / r, d[2] / r);
-            rows.push([
-                x,
-                y,
-                x * x,
-                x * y,
-                y * y,
-                x * x * x,
-                x * x * y,
-                x * y * y,
-                y * y * y,
-            ]);
-            rhs.push(z);
-        }
-        let m = DMatrix::from_fn(rows.len(), 9, |a, b| rows[a][b]);
-        let b = nalgebra::DVector::from_column_slice(&rhs);
+        // The cubic jet z(x, y) in the scaled frame, one row of monomials per neighbour.
+        let m = DMatrix::from_row_iterator(
+            local.len(),
+            9,
+            local.iter().flat_map(|d| {
+                let (x, y) = (d[0] / r, d[1] / r);
+                [
+                    x,
+                    y,
+                    x * x,
+                    x * y,
+                    y * y,
+                    x * x * x,
+                    x * x * y,
+                    x * y * y,
+                    y * y * y,
+                ]
+            }),
+        );
+        let b = nalgebra::DVector::from_iterator(local.len(), local.iter().map(|d| d[2] / r));
         let svd = m.svd(true, true);
         // Too few independent directions (points on a curve): keep the first estimate.
         let smax = svd.singular_values.max();

@@ -31,20 +31,36 @@ const EARLY_REVIEW: f64 = 0.5;
 
 /// What a query costs on cells `2^d` times smaller than its own level's (`d < 0`: larger),
 /// relative to one on its own level. A query of `ρ` cells ([`TARGET_REACH`] on its own
-/// level) looks up the `(1 + 2ρ)³` cells of its box and tests the points of the surface
-/// patch `1 + 2ρ` cells wide, `(1 + 2ρ)² / ρ²` query radii squared, at a spacing about the
-/// query radius. On cells too small the lookups grow as `8^d`, on cells too large the
+/// level) looks up the `(1 + 2ρ)³` cells of its box, and tests every point on the part of
+/// the surface they hold: a patch `(1 + 2ρ) / ρ` query radii wide, with points about a query
+/// radius apart, so `((1 + 2ρ) / ρ)²` of them. On cells too small the lookups grow as `8^d`, on cells too large the
 /// candidates as `4^|d|`: a query 16 times its level's size costs about 190 on-level queries,
 /// one 2 times its size 1.7. (A flat `3^|d|`, the model before, kept the 10:1 elliptic
 /// cylinder `[1, 100, 0]` from its rim on one level for the 5% of its queries that wanted
 /// cells 16 times as wide: they made 50% of its 34M cell lookups.)
 fn off_level_cost(d: i32) -> f64 {
     let cost = |d: i32| {
-        let scale = f64::from(d.clamp(-40, 40)).exp2();
+        let scale = f64::from(d.clamp(-OFF_LEVELS, OFF_LEVELS)).exp2();
         let wide = 1.0 + 2.0 * TARGET_REACH * scale;
         LOOKUP_COST * wide.powi(3) + (wide / (TARGET_REACH * scale)).powi(2)
     };
     cost(d) / cost(0)
+}
+
+/// The index in [`off_level_costs`] of `d` levels off.
+fn off(d: i32) -> usize {
+    (d.clamp(-OFF_LEVELS, OFF_LEVELS) + OFF_LEVELS) as usize
+}
+
+/// [`off_level_cost`] is the same beyond this many levels off.
+const OFF_LEVELS: i32 = 40;
+
+/// [`off_level_cost`] for `d` in `-OFF_LEVELS..=OFF_LEVELS` (index `d + OFF_LEVELS`), worked
+/// out once: every query off its level adds it to [`Grid::excess`].
+fn off_level_costs() -> &'static [f64; 2 * OFF_LEVELS as usize + 1] {
+    static COSTS: std::sync::OnceLock<[f64; 2 * OFF_LEVELS as usize + 1]> =
+        std::sync::OnceLock::new();
+    COSTS.get_or_init(|| std::array::from_fn(|i| off_level_cost(i as i32 - OFF_LEVELS)))
 }
 
 /// Levels are indexed by `k` in `-MAX_LEVEL..=MAX_LEVEL`: cells of `2^k` base cells.
@@ -172,15 +188,13 @@ impl Grid {
         }
         let n = positions.len() as f64;
         let current: Vec<i32> = self.levels.iter().map(|l| l.k).collect();
+        let costs = off_level_costs();
         let cost = |set: &[i32]| {
             let queries: f64 = asked
                 .iter()
                 .map(|&(k, count)| {
-                    let cheapest = set
-                        .iter()
-                        .map(|&s| off_level_cost(k - s))
-                        .fold(f64::INFINITY, f64::min);
-                    count * if cheapest.is_finite() { cheapest } else { 1.0 }
+                    let cheapest = set.iter().map(|&s| costs[off(k - s)]).reduce(f64::min);
+                    count * cheapest.unwrap_or(1.0)
                 })
                 .sum();
             let made = set.iter().filter(|k| !current.contains(k)).count() as f64;
@@ -246,7 +260,7 @@ impl Grid {
             *n = n.saturating_add(1);
         }
         if level.k != want {
-            let extra = off_level_cost(want - level.k) - 1.0;
+            let extra = off_level_costs()[off(want - level.k)] - 1.0;
             self.excess.set(self.excess.get() + extra);
         }
         level
