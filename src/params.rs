@@ -610,9 +610,15 @@ impl MeshParams {
         }
         let (bmin, bmax) = (self.beta_min.radians(), self.beta_max.radians());
         if !(bmin > 0.0 && bmin < bmax && bmax < std::f64::consts::FRAC_PI_2) {
+            // Degrees as typed: the round trip through radians leaves `-3` as
+            // `-3.0000000000000004`; thirteen significant digits drop that.
+            let as_typed = |a: Angle| {
+                let d = a.degrees();
+                format!("{d:.12e}").parse().unwrap_or(d)
+            };
             return Err(MeshError::AngleBand {
-                min_deg: self.beta_min.degrees(),
-                max_deg: self.beta_max.degrees(),
+                min_deg: as_typed(self.beta_min),
+                max_deg: as_typed(self.beta_max),
             });
         }
         if self.grow <= 1.0 {

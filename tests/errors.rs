@@ -60,6 +60,9 @@ fn an_inverted_or_empty_angle_band_is_rejected() {
     assert!(matches!(e, MeshError::AngleBand { .. }), "{e}");
     let e = with(|p| p.beta_min = p.beta_max).unwrap_err();
     assert!(matches!(e, MeshError::AngleBand { .. }));
+    // The degrees come back as typed, not through radians' rounding (-3.0000000000000004).
+    let e = with(|p| p.beta_min = Angle::from_degrees(-3.0)).unwrap_err();
+    assert!(e.to_string().contains("[-3°, 8°]"), "{e}");
 }
 
 #[test]
