@@ -676,16 +676,16 @@ pub(crate) fn stitch<T: Scalar, F: NormalField<T>>(
     // larger holes into the surface's boundary (a cone's apex), or close the best state's
     // small ones.
     match best.filter(|b| b.open.better_than(&s.open_boundary())) {
-        None => (s, out) = s.charts_or_keep(out, mesh, rim, free),
+        None => (s, out) = s.charts_or_keep(out, mesh, free),
         Some(best) => {
             let last = s.snapshot(&out);
-            (s, out) = s.restore(best, mesh, rim, free);
-            (s, out) = s.charts_or_keep(out, mesh, rim, free);
+            (s, out) = s.restore(best, mesh, free);
+            (s, out) = s.charts_or_keep(out, mesh, free);
             let from_best = s.snapshot(&out);
-            (s, out) = s.restore(last, mesh, rim, free);
-            (s, out) = s.charts_or_keep(out, mesh, rim, free);
+            (s, out) = s.restore(last, mesh, free);
+            (s, out) = s.charts_or_keep(out, mesh, free);
             if from_best.open.closer_than(&s.open_boundary()) {
-                (s, out) = s.restore(from_best, mesh, rim, free);
+                (s, out) = s.restore(from_best, mesh, free);
             }
         }
     }
@@ -756,6 +756,9 @@ struct Snapshot<T> {
     nrm: Vec<[f64; 3]>,
     prov: Vec<Provenance>,
     work: Vec<Vec3<T>>,
+    /// Which vertices are on the surface's rim (the front's new points at the box or the
+    /// radius among them).
+    rim: Vec<Rim>,
     /// Its [`Stitcher::open_boundary`].
     open: OpenBoundary,
     /// What the stitching had done until then.
@@ -986,18 +989,18 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
             nrm: self.nrm.clone(),
             prov: self.prov.clone(),
             work: self.work.clone(),
+            rim: self.rim.clone(),
             open: self.open_boundary(),
             out: *out,
         }
     }
 
-    /// A stitcher started anew from `snapshot`, with `mesh`, `rim` and `free` as given to
+    /// A stitcher started anew from `snapshot`, with `mesh` and `free` as given to
     /// [`stitch`]; and what the stitching had done until then.
     fn restore(
         self,
         snapshot: Snapshot<T>,
         mesh: &mut Mesh,
-        rim: &[Rim],
         free: &[(u32, f64)],
     ) -> (Self, Stitched) {
         let initial = snapshot.tris[..self.initial]
@@ -1011,7 +1014,7 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
         mesh.normals = snapshot.nrm;
         mesh.provenance = snapshot.prov;
         mesh.triangles = snapshot.tris.into_iter().filter(|t| *t != DEAD).collect();
-        let mut s = Stitcher::new(mesh, work, rim, free, growth);
+        let mut s = Stitcher::new(mesh, work, &snapshot.rim, free, growth);
         // (The chart's triangles come first and keep their order.)
         s.initial = initial;
         s.visits.set(visits);
@@ -1024,14 +1027,13 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
         mut self,
         mut out: Stitched,
         mesh: &mut Mesh,
-        rim: &[Rim],
         free: &[(u32, f64)],
     ) -> (Self, Stitched) {
         let before = (self.growth.new_points && self.open_boundary().hole_edges > 0)
             .then(|| self.snapshot(&out));
         out.added += self.fill_holes_by_chart(&mut out);
         match before.filter(|b| b.open.better_than(&self.open_boundary())) {
-            Some(before) => self.restore(before, mesh, rim, free),
+            Some(before) => self.restore(before, mesh, free),
             None => (self, out),
         }
     }
