@@ -33,14 +33,14 @@ const EARLY_REVIEW: f64 = 0.5;
 /// relative to one on its own level. A query of `ρ` cells ([`TARGET_REACH`] on its own
 /// level) looks up the `(1 + 2ρ)³` cells of its box, and tests every point on the part of
 /// the surface they hold: a patch `(1 + 2ρ) / ρ` query radii wide, with points about a query
-/// radius apart, so `((1 + 2ρ) / ρ)²` of them. On cells too small the lookups grow as `8^d`, on cells too large the
-/// candidates as `4^|d|`: a query 16 times its level's size costs about 190 on-level queries,
-/// one 2 times its size 1.7. (A flat `3^|d|`, the model before, kept the 10:1 elliptic
-/// cylinder `[1, 100, 0]` from its rim on one level for the 5% of its queries that wanted
-/// cells 16 times as wide: they made 50% of its 34M cell lookups.)
+/// radius apart, so `((1 + 2ρ) / ρ)²` of them. On cells too small the lookups grow as `8^d`,
+/// on cells too large the candidates as `4^|d|`: a query 16 times its level's size costs
+/// about 190 on-level queries, one 2 times its size 1.7. (A flat `3^|d|`, the model before,
+/// kept the 10:1 elliptic cylinder `[1, 100, 0]` from its rim on one level for the 5% of its
+/// queries that wanted cells 16 times as wide: they made 50% of its 34M cell lookups.)
 fn off_level_cost(d: i32) -> f64 {
     let cost = |d: i32| {
-        let scale = f64::from(d.clamp(-OFF_LEVELS, OFF_LEVELS)).exp2();
+        let scale = f64::from(d).exp2();
         let wide = 1.0 + 2.0 * TARGET_REACH * scale;
         LOOKUP_COST * wide.powi(3) + (wide / (TARGET_REACH * scale)).powi(2)
     };
@@ -52,7 +52,7 @@ fn off(d: i32) -> usize {
     (d.clamp(-OFF_LEVELS, OFF_LEVELS) + OFF_LEVELS) as usize
 }
 
-/// [`off_level_cost`] is the same beyond this many levels off.
+/// Queries more than this many levels off are priced as this many ([`off`]).
 const OFF_LEVELS: i32 = 40;
 
 /// [`off_level_cost`] for `d` in `-OFF_LEVELS..=OFF_LEVELS` (index `d + OFF_LEVELS`), worked

@@ -191,6 +191,19 @@ fn rim_of<T>(samples: &Samples<T>, pr: &Provenance) -> stitch::Rim {
     }
 }
 
+/// Whether a point `q` at geodesic distance `s` from `p0` lies within `reach` of the bounding
+/// box or of the geodesic radius: the surface ends there as it does at the end of a curve
+/// that reached them.
+pub(crate) fn near_terminal(
+    q: [f64; 3],
+    s: f64,
+    reach: f64,
+    bounding_box: f64,
+    max_radius: f64,
+) -> bool {
+    q.iter().any(|x| x.abs() >= bounding_box - reach) || s >= max_radius - reach
+}
+
 /// How many loops of `boundary`'s edges (vertex pairs of `mesh`; loops that touch at a vertex
 /// count as one) have no vertex on the surface's own rim (see [`Stitched::holes`]).
 ///
@@ -245,16 +258,19 @@ pub(crate) fn holes<T>(
     let mut off_rim = vec![false; ends.len()];
     let turn = axis.map(|axis| turns_about(mesh, boundary, axis));
     for (k, &v) in ends.iter().enumerate() {
-        let ended = mesh.provenance.get(v as usize).is_some_and(|pr| {
-            rim_of(samples, pr) != stitch::Rim::Open || pr.s >= params.max_radius - reach[k]
-        });
-        let at_box = mesh
-            .vertices
-            .get(v as usize)
-            .is_some_and(|q| q.iter().any(|x| x.abs() >= params.bounding_box - reach[k]));
+        let rim = match (
+            mesh.provenance.get(v as usize),
+            mesh.vertices.get(v as usize),
+        ) {
+            (Some(pr), Some(&q)) => {
+                rim_of(samples, pr) != stitch::Rim::Open
+                    || near_terminal(q, pr.s, reach[k], params.bounding_box, params.max_radius)
+            }
+            _ => false,
+        };
         let root = loops.find(k as u32) as usize;
-        on_rim[root] |= ended || at_box;
-        off_rim[root] |= !(ended || at_box);
+        on_rim[root] |= rim;
+        off_rim[root] |= !rim;
     }
     // Each loop's turn about the axis: its boundary edges' angles summed.
     let mut turns = vec![0.0f64; ends.len()];

@@ -1362,14 +1362,17 @@ impl<'a, 'f, T: Scalar, F: NormalField<T>> Stitcher<'a, 'f, T, F> {
         let h = h.max(dist(self.pos[a as usize], self.pos[b as usize]));
         self.boundary.set_scale(v, h);
         self.points.insert(v, self.pos[v as usize]);
-        // Within an edge of the box or of the geodesic radius the surface ends as it does at
-        // the end of a curve that reached them (the rule of `triangulate::holes`): the
-        // front's new points along a band's end at the box are its rim, not a front left
-        // open (which would send the stitching round again for nothing).
-        let (q, s) = (self.pos[v as usize], self.prov[v as usize].s);
-        if q.iter().any(|x| x.abs() >= self.growth.bounding_box - h)
-            || s >= self.growth.max_radius - h
-        {
+        // Within an edge of the box or of the geodesic radius (the rule of
+        // `triangulate::holes`), the front's new points along a band's end are its rim, not a
+        // front left open (which would send the stitching round again for nothing).
+        let g = self.growth;
+        if super::near_terminal(
+            self.pos[v as usize],
+            self.prov[v as usize].s,
+            h,
+            g.bounding_box,
+            g.max_radius,
+        ) {
             self.rim[v as usize] = Rim::Terminal;
         }
     }
