@@ -1253,6 +1253,31 @@ mod tests {
         }
     }
 
+    /// The rim rule shared by the holes count and the stitcher's new points: within `reach`
+    /// of any face of the box (either sign, any axis) or of the geodesic radius, and nowhere
+    /// else.
+    #[test]
+    fn near_terminal_is_within_reach_of_the_box_or_the_radius() {
+        let (reach, bounding_box, max_radius) = (0.5, 10.0, 20.0);
+        let near = |q: [f64; 3], s: f64| near_terminal(q, s, reach, bounding_box, max_radius);
+        assert!(!near([0.0, 0.0, 0.0], 0.0));
+        assert!(!near([9.49, -9.49, 9.49], 19.49));
+        for k in 0..3 {
+            for sign in [1.0, -1.0] {
+                let mut q = [1.0, 2.0, 3.0];
+                q[k] = sign * 9.5;
+                assert!(near(q, 5.0), "{q:?}");
+                q[k] = sign * 9.49;
+                assert!(!near(q, 5.0), "{q:?}");
+            }
+        }
+        assert!(near([0.0; 3], 19.5));
+        assert!(near([0.0; 3], 25.0));
+        // No reach: only what reached the box or the radius.
+        assert!(!near_terminal([9.99, 0.0, 0.0], 19.99, 0.0, 10.0, 20.0));
+        assert!(near_terminal([-10.0, 0.0, 0.0], 0.0, 0.0, 10.0, 20.0));
+    }
+
     /// Filed by rows, the even-odd test answers as the edge-by-edge one bit for bit, on
     /// random polygons (also self-intersecting ones, with repeated and horizontal edges) and
     /// on points at their vertices' coordinates (on horizontal edges, even).
