@@ -205,6 +205,41 @@ fn each_error_is_printed_once() {
     }
 }
 
+/// A batch row says what `liemesh mesh` says of the same run: a run cut short by a budget is
+/// INCOMPLETE there too, not a finished mesh.
+#[test]
+fn batch_says_which_runs_were_cut_short() {
+    let dir = scratch("batch-budget");
+    let budget = dir.join("budget.toml");
+    std::fs::write(
+        &budget,
+        "invariant = [1, 4, 16, 0, 0, 0]\n[mesh]\np0 = [0.6, 0.4, 0.0]\nmax_points = 500\n",
+    )
+    .unwrap();
+    let o = liemesh()
+        .arg("batch")
+        .arg(&budget)
+        .arg("-o")
+        .arg(dir.join("out"))
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(0));
+    let out = String::from_utf8_lossy(&o.stdout);
+    assert!(
+        out.contains("INCOMPLETE the point budget (max_points = 500) ran out"),
+        "{out}"
+    );
+    let single = liemesh()
+        .args(["mesh", "--invariant"])
+        .arg(&budget)
+        .arg("-o")
+        .arg(dir.join("single.ply"))
+        .output()
+        .unwrap();
+    let single = String::from_utf8_lossy(&single.stdout);
+    assert!(single.contains("INCOMPLETE the point budget"), "{single}");
+}
+
 #[test]
 fn a_failed_run_still_writes_its_report_saying_why() {
     let dir = scratch("failed");

@@ -44,7 +44,17 @@ pub struct BatchItem {
     /// The invariant file.
     pub input: PathBuf,
     /// The mesh written, or why there is none.
-    pub result: Result<BatchDone, String>,
+    pub result: Result<BatchDone, BatchFailure>,
+}
+
+/// Why one input has no mesh.
+#[derive(Debug, Clone)]
+pub struct BatchFailure {
+    /// The error, as `liemesh mesh` would print it.
+    pub message: String,
+    /// Whether the mesh failed its own validation (a failed check, exit code 1, as for
+    /// `liemesh mesh`) rather than the input being unusable (exit code 2).
+    pub invalid_mesh: bool,
 }
 
 /// One input meshed successfully.
@@ -56,6 +66,10 @@ pub struct BatchDone {
     pub triangles: usize,
     /// Whether the mesh is closed.
     pub closed: bool,
+    /// Boundary loops where the surface goes on (see the `mesh` summary's `holes`).
+    pub holes: usize,
+    /// What cut the run short, if anything (the `mesh` summary's `INCOMPLETE`).
+    pub cut_short: Vec<String>,
     /// Wall-clock seconds of this input (meshing and writing).
     pub seconds: f64,
 }
@@ -124,6 +138,8 @@ fn mesh_one(input: &Path, out: &Path, format: MeshFormat) -> Result<BatchDone, C
         mesh: mesh_path,
         triangles: report.triangles,
         closed: report.closed,
+        holes: report.stitched.holes,
+        cut_short: report.cut_short.clone(),
         seconds: t0.elapsed().as_secs_f64(),
     })
 }
@@ -134,7 +150,10 @@ pub fn batch(files: &[PathBuf], out: &Path, format: MeshFormat) -> Vec<BatchItem
         .par_iter()
         .map(|input| BatchItem {
             input: input.clone(),
-            result: mesh_one(input, out, format).map_err(|e| e.to_string()),
+            result: mesh_one(input, out, format).map_err(|e| BatchFailure {
+                message: e.to_string(),
+                invalid_mesh: matches!(e, CliError::Mesh(liemesh::MeshError::Invalid(_))),
+            }),
         })
         .collect()
 }
@@ -150,14 +169,29 @@ pub fn run(args: &BatchArgs) -> Result<ExitCode, CliError> {
     if !args.quiet {
         for item in &items {
             match &item.result {
-                Ok(d) => println!(
-                    "{:<40} {:>9} triangles  {:<6} {:>9.1} ms  {}",
-                    item.input.display(),
-                    d.triangles,
-                    if d.closed { "closed" } else { "open" },
-                    d.seconds * 1e3,
-                    d.mesh.display()
-                ),
+                Ok(d) => {
+                    println!(
+                        "{:<40} {:>9} triangles  {:<6} {:>9.1} ms  {}",
+                        item.input.display(),
+                        d.triangles,
+                        if d.closed { "closed" } else { "open" },
+                        d.seconds * 1e3,
+                        d.mesh.display()
+                    );
+                    // What `liemesh mesh` would say about the same run, so that a cut-short
+                    // or holed mesh does not pass for a finished one.
+                    if d.holes > 0 {
+                        println!(
+                            "{:<40} holes: {} boundary loop{} where the surface goes on",
+                            "",
+                            d.holes,
+                            if d.holes == 1 { "" } else { "s" }
+                        );
+                    }
+                    if !d.cut_short.is_empty() {
+                        println!("{:<40} INCOMPLETE {}", "", d.cut_short.join("; "));
+                    }
+                }
                 // The error itself goes to standard error, once (below).
                 Err(_) => println!("{:<40} FAILED", item.input.display()),
             }
@@ -177,12 +211,15 @@ pub fn run(args: &BatchArgs) -> Result<ExitCode, CliError> {
         );
     }
     if failed > 0 {
-        for item in items.iter().filter(|i| i.result.is_err()) {
+        let mut unusable = false;
+        for item in &items {
             if let Err(e) = &item.result {
-                eprintln!("liemesh: error: {}: {e}", item.input.display());
+                eprintln!("liemesh: error: {}: {}", item.input.display(), e.message);
+                unusable |= !e.invalid_mesh;
             }
         }
-        return Ok(ExitCode::from(2));
+        // As `liemesh mesh`: bad input is 2; meshes that failed their validation, 1.
+        return Ok(ExitCode::from(if unusable { 2 } else { 1 }));
     }
     Ok(ExitCode::SUCCESS)
 }
