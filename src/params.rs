@@ -93,6 +93,27 @@ pub enum Mode {
     Default,
 }
 
+/// Points and directions read as exactly three numbers: serde's arrays take the first three
+/// of a longer list and leave the rest unread, so `p0 = [1, 0, 0, 7]` would run silently at
+/// `(1, 0, 0)`.
+#[cfg(feature = "serde")]
+mod three {
+    use serde::de::{Deserialize, Deserializer, Error};
+
+    fn three<E: Error>(v: Vec<f64>) -> Result<[f64; 3], E> {
+        <[f64; 3]>::try_from(v.as_slice())
+            .map_err(|_| E::invalid_length(v.len(), &"an array of length 3 (x, y, z)"))
+    }
+
+    pub(super) fn exactly<'de, D: Deserializer<'de>>(d: D) -> Result<[f64; 3], D::Error> {
+        three(Vec::deserialize(d)?)
+    }
+
+    pub(super) fn optional<'de, D: Deserializer<'de>>(d: D) -> Result<Option<[f64; 3]>, D::Error> {
+        Option::<Vec<f64>>::deserialize(d)?.map(three).transpose()
+    }
+}
+
 /// All parameters of one meshing run.
 ///
 /// `None` lengths and `w00` are automatic (see [`MeshParams::resolve`]). The defaults mesh
@@ -119,9 +140,11 @@ pub struct MeshParams {
     /// Step rule.
     pub mode: Mode,
     /// Initial point.
+    #[cfg_attr(feature = "serde", serde(deserialize_with = "three::exactly"))]
     pub p0: [f64; 3],
     /// Initial direction (projected onto the tangent plane at `p0`); automatic: the
     /// coordinate axis least aligned with the normal at `p0`.
+    #[cfg_attr(feature = "serde", serde(deserialize_with = "three::optional"))]
     pub w00: Option<[f64; 3]>,
     /// Initial step Δt; automatic: a tenth of the step scale, or twice `beta_max` (in radians)
     /// step scales when that is smaller.

@@ -159,6 +159,29 @@ mod tests {
         );
     }
 
+    /// A point or direction is three numbers: a fourth is refused, not dropped.
+    #[test]
+    fn points_and_directions_take_exactly_three_numbers() {
+        let head = "invariant = [1, 4, 9, 0, 0, 0]\n[mesh]\n";
+        let f = parse(&format!("{head}p0 = [1, 0, 0]\nw00 = [0, 1, 0]")).unwrap();
+        assert_eq!(
+            (f.params.p0, f.params.w00),
+            ([1.0, 0.0, 0.0], Some([0.0, 1.0, 0.0]))
+        );
+        for bad in [
+            "p0 = [1, 0, 0, 0]",
+            "p0 = [1, 0]",
+            "p0 = [1, 0, 0]\nw00 = [0, 1, 0, 5]",
+            "w00 = []",
+        ] {
+            let msg = parse(&format!("{head}{bad}")).unwrap_err().to_string();
+            assert!(
+                msg.contains("expected an array of length 3"),
+                "{bad}: {msg}"
+            );
+        }
+    }
+
     #[test]
     fn a_wrong_count_names_the_key() {
         let msg = parse("invariant = [1, 1]").unwrap_err().to_string();
