@@ -240,6 +240,66 @@ fn batch_says_which_runs_were_cut_short() {
     assert!(single.contains("INCOMPLETE the point budget"), "{single}");
 }
 
+/// Arguments that cannot work together are refused before any meshing: from a singular
+/// `p0`, whose run would fail first, the error is the arguments', not the run's.
+#[test]
+fn conflicting_arguments_are_refused_before_meshing() {
+    let dir = scratch("conflicts");
+    let singular = dir.join("singular.toml");
+    std::fs::write(
+        &singular,
+        "invariant = [1, 1, 1, 0, 0, 0]\n[mesh]\np0 = [0, 0, 0]\n",
+    )
+    .unwrap();
+    let a_file = dir.join("a-file");
+    std::fs::write(&a_file, "").unwrap();
+    let in_file = a_file.join("x.ply");
+    let x = |name: &str| dir.join(name).to_string_lossy().into_owned();
+    let cases: Vec<(Vec<String>, &str)> = vec![
+        (
+            vec!["-o".into(), x("x.stl"), "--derivative".into(), "1".into()],
+            "give an output ending in .ply",
+        ),
+        (
+            vec![
+                "-o".into(),
+                x("x.ply"),
+                "--derivative".into(),
+                "1".into(),
+                "--scalar".into(),
+                "f32".into(),
+            ],
+            "leave out --scalar",
+        ),
+        (
+            vec!["-o".into(), x("x.ply"), "--derivative".into(), "7".into()],
+            "the invariant has 6 numbers",
+        ),
+        (
+            vec!["-o".into(), in_file.to_string_lossy().into_owned()],
+            "is a file, not a folder",
+        ),
+        (
+            vec!["-o".into(), x("x.ply"), "--png".into(), x("x.jpg")],
+            "must end in .png or .svg",
+        ),
+    ];
+    for (args, says) in cases {
+        let o = liemesh()
+            .args(["mesh", "--invariant"])
+            .arg(&singular)
+            .args(&args)
+            .output()
+            .unwrap();
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{args:?}: {err}");
+        assert!(
+            err.contains(says) && !err.contains("singular"),
+            "{args:?}: {err}"
+        );
+    }
+}
+
 #[test]
 fn a_failed_run_still_writes_its_report_saying_why() {
     let dir = scratch("failed");

@@ -419,6 +419,17 @@ pub(super) fn run(args: &MeshArgs) -> Result<ExitCode, CliError> {
     if let Some(out) = &args.output {
         io::MeshFormat::from_path(out)?;
     }
+    check_derivative_args(args, &invariant)?;
+    for path in [&args.output, &args.report, &args.png]
+        .into_iter()
+        .flatten()
+    {
+        check_output_folder(path)?;
+    }
+    if let Some(png) = &args.png {
+        super::picture::picture_format(png)?;
+        super::picture::check_options(&args.picture.options())?;
+    }
     let scalar = ScalarKind::from(args.scalar);
     let measure = args.report.is_some() || args.json;
     let job = Job::new(
@@ -482,8 +493,29 @@ fn derivatives(
     mesh: &Mesh,
     status: &Status,
 ) -> Result<Vec<VertexDerivatives>, CliError> {
+    check_derivative_args(args, invariant)?;
+    let mut out = Vec::new();
+    for &number in &args.derivative {
+        // The 6 numbers of a linear invariant are the first row of the 18-number layout.
+        let index = number - 1;
+        status.step(format!("differentiating by invariant number {number}"));
+        let d = liemesh::differentiate(&LieField::<f64>::seeded(invariant, index), params)?;
+        if d.mesh.vertices != mesh.vertices || d.mesh.triangles != mesh.triangles {
+            return Err(CliError::Usage(format!(
+                "--derivative {number}: the dual-number run decided differently from the f64 \
+                 run (this is a bug; please report it with the invariant file)"
+            )));
+        }
+        out.push(VertexDerivatives::new(number, d.d_vertices));
+    }
+    Ok(out)
+}
+
+/// What `--derivative` needs of the other arguments, checked before the mesh is made (a
+/// conflict found after a long run wastes it).
+fn check_derivative_args(args: &MeshArgs, invariant: &Invariant) -> Result<(), CliError> {
     if args.derivative.is_empty() {
-        return Ok(Vec::new());
+        return Ok(());
     }
     if args.scalar != ScalarArg::F64 {
         return Err(CliError::Usage(
@@ -500,26 +532,36 @@ fn derivatives(
         }
     }
     let count = invariant.numbers().len();
-    let mut out = Vec::new();
-    for &number in &args.derivative {
-        if number == 0 || number > count {
-            return Err(CliError::Usage(format!(
-                "--derivative {number}: the invariant has {count} numbers, counted from 1"
-            )));
-        }
-        // The 6 numbers of a linear invariant are the first row of the 18-number layout.
-        let index = number - 1;
-        status.step(format!("differentiating by invariant number {number}"));
-        let d = liemesh::differentiate(&LieField::<f64>::seeded(invariant, index), params)?;
-        if d.mesh.vertices != mesh.vertices || d.mesh.triangles != mesh.triangles {
-            return Err(CliError::Usage(format!(
-                "--derivative {number}: the dual-number run decided differently from the f64 \
-                 run (this is a bug; please report it with the invariant file)"
-            )));
-        }
-        out.push(VertexDerivatives::new(number, d.d_vertices));
+    if let Some(number) = args
+        .derivative
+        .iter()
+        .find(|&&number| number == 0 || number > count)
+    {
+        return Err(CliError::Usage(format!(
+            "--derivative {number}: the invariant has {count} numbers, counted from 1"
+        )));
     }
-    Ok(out)
+    Ok(())
+}
+
+/// An output's folder is made if missing, so a path is unusable only where some part of
+/// its folder is a file: said before the mesh is made, not after.
+fn check_output_folder(path: &Path) -> Result<(), CliError> {
+    let mut folder = path.parent();
+    while let Some(f) = folder.filter(|f| !f.as_os_str().is_empty()) {
+        if f.exists() {
+            if f.is_dir() {
+                return Ok(());
+            }
+            return Err(CliError::Usage(format!(
+                "cannot write {}: {} is a file, not a folder",
+                path.display(),
+                f.display()
+            )));
+        }
+        folder = f.parent();
+    }
+    Ok(())
 }
 
 /// Writes the mesh, with the derivatives as PLY vertex properties when there are any.

@@ -585,6 +585,35 @@ pub fn render_svg(mesh: &Mesh, options: &RenderOptions) -> Result<String, Render
     ))
 }
 
+/// The picture formats [`render_to_file`] writes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum PictureFormat {
+    /// A raster image.
+    Png,
+    /// A vector image.
+    Svg,
+}
+
+/// The format [`render_to_file`] would write to `path`, by its extension (any case); callers
+/// check it before the work that makes the mesh.
+///
+/// # Errors
+///
+/// [`RenderError::UnsupportedExtension`] unless the name ends in `.png` or `.svg`.
+pub fn picture_format(path: &Path) -> Result<PictureFormat, RenderError> {
+    let extension = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(str::to_ascii_lowercase);
+    match extension.as_deref() {
+        Some("png") => Ok(PictureFormat::Png),
+        Some("svg") => Ok(PictureFormat::Svg),
+        _ => Err(RenderError::UnsupportedExtension {
+            path: path.to_path_buf(),
+        }),
+    }
+}
+
 /// Renders `mesh` and writes the picture to `path`, as PNG if the path ends
 /// in `.png` and as SVG if it ends in `.svg` (case-insensitive).
 ///
@@ -602,18 +631,9 @@ pub fn render_to_file(
     options: &RenderOptions,
 ) -> Result<(), RenderError> {
     let path = path.as_ref();
-    let extension = path
-        .extension()
-        .and_then(|e| e.to_str())
-        .map(str::to_ascii_lowercase);
-    let bytes = match extension.as_deref() {
-        Some("png") => render_png(mesh, options)?,
-        Some("svg") => render_svg(mesh, options)?.into_bytes(),
-        _ => {
-            return Err(RenderError::UnsupportedExtension {
-                path: path.to_path_buf(),
-            })
-        }
+    let bytes = match picture_format(path)? {
+        PictureFormat::Png => render_png(mesh, options)?,
+        PictureFormat::Svg => render_svg(mesh, options)?.into_bytes(),
     };
     std::fs::write(path, bytes).map_err(|source| RenderError::Io {
         path: path.to_path_buf(),
@@ -755,7 +775,9 @@ impl Camera {
     }
 }
 
-fn check_options(options: &RenderOptions) -> Result<(), RenderError> {
+/// Whether `options` can be drawn (a size in range, a finite line width and margin);
+/// callers check it before the work that makes the mesh.
+pub(crate) fn check_options(options: &RenderOptions) -> Result<(), RenderError> {
     let (width, height) = (options.width, options.height);
     if width == 0 || height == 0 || width > MAX_IMAGE_SIZE || height > MAX_IMAGE_SIZE {
         return Err(RenderError::BadSize { width, height });
