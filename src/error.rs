@@ -52,6 +52,21 @@ pub enum MeshError {
         /// The field value there.
         normal: [f64; 3],
     },
+    /// `v(p0)` gives a direction, but the surface's bend there (the field's derivative
+    /// over its length) is not finite in `f64`.
+    #[error(
+        "the normal field at p0 = {p0:?} is {normal:?}, but how the surface bends there (the \
+         field's derivative over its length) is not finite in f64: the surface bends too \
+         sharply at p0 for f64 geometry, or the field is not differentiable there; scale the \
+         field's coordinates or its numbers into a narrower range, or choose another initial \
+         point"
+    )]
+    BendAtInitialPoint {
+        /// The initial point.
+        p0: [f64; 3],
+        /// The field value there.
+        normal: [f64; 3],
+    },
     /// The surface at `p0` is too small or too large for `f64` geometry.
     #[error(
         "the surface at p0 has size {size:e} (its radius of curvature there, or p0's distance \
@@ -142,13 +157,33 @@ pub enum MeshError {
 
 impl MeshError {
     /// The error for a `p0` where the field, `normal`, gives no unit normal or no shape in
-    /// `f64`: [`MeshError::FieldMagnitude`] when it is finite and not zero but its squared
-    /// length is not a normal number, [`MeshError::SingularInitialPoint`] otherwise.
+    /// `f64`: [`MeshError::SurfaceScale`] when `p0` itself lies beyond the sizes meshed (the
+    /// field overflows there), [`MeshError::FieldMagnitude`] when the field is finite and not
+    /// zero but its squared length is not a normal number, [`MeshError::BendAtInitialPoint`]
+    /// when it gives a direction but no shape, [`MeshError::SingularInitialPoint`] otherwise.
     pub(crate) fn no_normal_at(p0: [f64; 3], normal: [f64; 3]) -> MeshError {
+        // |p0| without overflow in the squares.
+        let largest = p0.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+        let size = if largest > 0.0 {
+            largest * p0.iter().map(|x| (x / largest).powi(2)).sum::<f64>().sqrt()
+        } else {
+            0.0
+        };
+        if !(size <= crate::params::MAX_SURFACE_SIZE) {
+            return MeshError::SurfaceScale {
+                size,
+                min: crate::params::MIN_SURFACE_SIZE,
+                max: crate::params::MAX_SURFACE_SIZE,
+            };
+        }
         let finite = normal.iter().all(|x| x.is_finite());
         let squared: f64 = normal.iter().map(|x| x * x).sum();
-        if finite && normal.iter().any(|&x| x != 0.0) && !squared.is_normal() {
-            MeshError::FieldMagnitude { p0, normal }
+        if finite && normal.iter().any(|&x| x != 0.0) {
+            if squared.is_normal() {
+                MeshError::BendAtInitialPoint { p0, normal }
+            } else {
+                MeshError::FieldMagnitude { p0, normal }
+            }
         } else {
             MeshError::SingularInitialPoint { p0, normal }
         }

@@ -158,3 +158,28 @@ fn a_field_too_long_or_too_short_for_f64_says_to_rescale_it() {
         assert_eq!(sphere(k).unwrap().triangles.len(), unit, "scaled by {k}");
     }
 }
+
+/// Where the field overflows because `p0` is far out, or gives a direction but no finite
+/// bend, the error says so and what to do, rather than calling `p0` a singular point (found
+/// by a new user's sweep: `p0 = (1e200, 1e200, 0)` and `λ = (1e-200, 1, 1e200)` from
+/// `(1, 1e-100, 0)` were both "the normal field vanishes ... choose another initial point").
+#[test]
+fn overflow_at_p0_is_told_apart_from_a_singular_point() {
+    let mesh = |numbers: [f64; 6], p0: [f64; 3]| {
+        let inv = Invariant::from_numbers(&numbers).unwrap();
+        generate(&LieField::<f64>::new(&inv), &MeshParams::at(p0))
+    };
+    let e = mesh([1.0, 1.0, 1.0, 0.0, 0.0, 0.0], [1e200, 1e200, 0.0]).unwrap_err();
+    match &e {
+        MeshError::SurfaceScale { size, .. } => {
+            assert!((size / 1e200 - 2f64.sqrt()).abs() < 1e-12, "{e}")
+        }
+        _ => panic!("{e}"),
+    }
+    let e = mesh([1e-200, 1.0, 1e200, 0.0, 0.0, 0.0], [1.0, 1e-100, 0.0]).unwrap_err();
+    assert!(matches!(e, MeshError::BendAtInitialPoint { .. }), "{e}");
+    assert!(e.to_string().contains("bends too sharply"), "{e}");
+    // A zero of the field is still a singular point.
+    let e = mesh([1.0, 1.0, 1.0, 0.0, 0.0, 0.0], [0.0, 0.0, 0.0]).unwrap_err();
+    assert!(matches!(e, MeshError::SingularInitialPoint { .. }), "{e}");
+}

@@ -406,7 +406,7 @@ pub fn mesher(data: &[u8]) -> Result<(), Violation> {
 ///   [`MeshParams::resolve`] gives; ones that resolve give a mesh, with those resolved
 ///   parameters, or one of the errors that depend on the field's course
 ///   ([`MeshError::SingularInitialPoint`], [`MeshError::FieldMagnitude`],
-///   [`MeshError::DirectionParallelToNormal`],
+///   [`MeshError::BendAtInitialPoint`], [`MeshError::DirectionParallelToNormal`],
 ///   [`MeshError::Triangulation`], [`MeshError::Empty`]), never [`MeshError::Invalid`];
 /// - the samples satisfy [`check_samples`] (budgets, step band, bookkeeping);
 /// - the chart triangulation satisfies [`check_chart`];
@@ -451,6 +451,7 @@ pub fn check_run(
                     e,
                     MeshError::SingularInitialPoint { .. }
                         | MeshError::FieldMagnitude { .. }
+                        | MeshError::BendAtInitialPoint { .. }
                         | MeshError::DirectionParallelToNormal { .. }
                         | MeshError::Triangulation(_)
                         | MeshError::Empty { .. }
