@@ -121,6 +121,29 @@ pub enum MeshError {
         /// What is allowed.
         why: &'static str,
     },
+    /// The point budget ran out and the samples made no mesh: too few for a triangle, or
+    /// none of their triangles survived validation.
+    #[error(
+        "the point budget max_points = {max_points} ran out after {points} sample point(s), \
+         and they made no triangle that survived validation; allow more points (max_points)"
+    )]
+    PointBudgetTooSmall {
+        /// The budget.
+        max_points: usize,
+        /// How many points the curves laid.
+        points: usize,
+    },
+    /// `p0` lies outside the bounding box, where every curve ends at once.
+    #[error(
+        "p0 = {p0:?} lies outside the bounding box (every coordinate within ±{bounding_box:e}), \
+         where every curve ends at once; give a larger bounding_box or a p0 inside it"
+    )]
+    OutsideBoundingBox {
+        /// The initial point.
+        p0: [f64; 3],
+        /// The box's half side.
+        bounding_box: f64,
+    },
     /// The previous method needs at least three curves to span the tangent plane.
     #[error("the previous method needs at least 3 curves (got {0}); set `curves` of `Method::Previous` to 3 or more")]
     TooFewCurves(usize),

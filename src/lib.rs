@@ -313,6 +313,14 @@ pub fn run_observed<T: Scalar, F: NormalField<T>>(
     }
     let params = &resolved;
     lap(&mut timings.sampling, &mut since);
+    // A budget too small for any mesh is named as such, not as the failure it leads to.
+    let too_small = || MeshError::PointBudgetTooSmall {
+        max_points: params.max_points,
+        points: samples.points.len(),
+    };
+    if samples.hit_point_budget && samples.points.len() < 3 {
+        return Err(too_small());
+    }
     let (points, curves) = (samples.points.len(), samples.curves.len());
     observe(Progress::at(Stage::Triangulating, points, curves, 0));
     let improve = params.mode == Mode::Default;
@@ -424,6 +432,9 @@ pub fn run_observed<T: Scalar, F: NormalField<T>>(
         return Err(MeshError::Invalid(Box::new(validation)));
     }
     if mesh.triangles.is_empty() {
+        if samples.hit_point_budget {
+            return Err(too_small());
+        }
         let swept = model::LocalShape::at::<T, F>(field, params.p0)
             .is_none_or(|shape| !shape.is_integrable());
         return Err(MeshError::Empty {

@@ -744,6 +744,14 @@ impl Resolved {
                 why: "the bounding box half-size must be greater than 0",
             });
         }
+        // (The automatic box is six extents, and the extent is at least p0's distance from
+        // the origin: only a box given can leave p0 out.)
+        if self.given.p0.iter().any(|x| x.abs() > self.bounding_box) {
+            return Err(MeshError::OutsideBoundingBox {
+                p0: self.given.p0,
+                bounding_box: self.bounding_box,
+            });
+        }
         Ok(())
     }
 }

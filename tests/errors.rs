@@ -183,3 +183,29 @@ fn overflow_at_p0_is_told_apart_from_a_singular_point() {
     let e = mesh([1.0, 1.0, 1.0, 0.0, 0.0, 0.0], [0.0, 0.0, 0.0]).unwrap_err();
     assert!(matches!(e, MeshError::SingularInitialPoint { .. }), "{e}");
 }
+
+/// A budget too small for any mesh, or a `p0` outside the box given, is named as such (a new
+/// user's sweep: `max_points = 3` was blamed on curves crossing near `p0`, a box that leaves
+/// `p0` out on "only 1 sample point").
+#[test]
+fn a_budget_too_small_or_a_p0_outside_the_box_is_named() {
+    let ellipsoid = Invariant::from_numbers(&[1.0, 4.0, 9.0, 0.0, 0.0, 0.0]).unwrap();
+    let mesh = |f: &dyn Fn(&mut MeshParams)| {
+        let mut p = MeshParams::at([1.0, 0.0, 0.0]);
+        f(&mut p);
+        generate(&LieField::<f64>::new(&ellipsoid), &p)
+    };
+    for budget in [1, 2, 3] {
+        let e = mesh(&|p| p.max_points = budget).unwrap_err();
+        assert!(
+            matches!(e, MeshError::PointBudgetTooSmall { max_points, .. } if max_points == budget),
+            "{budget}: {e}"
+        );
+        assert!(e.to_string().contains("allow more points"), "{e}");
+    }
+    let e = mesh(&|p| p.bounding_box = Some(0.5)).unwrap_err();
+    assert!(matches!(e, MeshError::OutsideBoundingBox { .. }), "{e}");
+    assert!(e.to_string().contains("larger bounding_box"), "{e}");
+    // A box that holds p0 meshes.
+    assert!(mesh(&|p| p.bounding_box = Some(1.5)).is_ok());
+}

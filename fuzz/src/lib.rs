@@ -407,6 +407,7 @@ pub fn mesher(data: &[u8]) -> Result<(), Violation> {
 ///   parameters, or one of the errors that depend on the field's course
 ///   ([`MeshError::SingularInitialPoint`], [`MeshError::FieldMagnitude`],
 ///   [`MeshError::BendAtInitialPoint`], [`MeshError::DirectionParallelToNormal`],
+///   [`MeshError::PointBudgetTooSmall`],
 ///   [`MeshError::Triangulation`], [`MeshError::Empty`]), never [`MeshError::Invalid`];
 /// - the samples satisfy [`check_samples`] (budgets, step band, bookkeeping);
 /// - the chart triangulation satisfies [`check_chart`];
@@ -452,6 +453,7 @@ pub fn check_run(
                     MeshError::SingularInitialPoint { .. }
                         | MeshError::FieldMagnitude { .. }
                         | MeshError::BendAtInitialPoint { .. }
+                        | MeshError::PointBudgetTooSmall { .. }
                         | MeshError::DirectionParallelToNormal { .. }
                         | MeshError::Triangulation(_)
                         | MeshError::Empty { .. }
