@@ -192,7 +192,7 @@ impl MeshError {
         } else {
             0.0
         };
-        if !(size <= crate::params::MAX_SURFACE_SIZE) {
+        if size > crate::params::MAX_SURFACE_SIZE {
             return MeshError::SurfaceScale {
                 size,
                 min: crate::params::MIN_SURFACE_SIZE,
