@@ -199,5 +199,16 @@ pub(super) fn recover_cmd(args: &RecoverArgs) -> Result<ExitCode, CliError> {
     if let Some(e) = r.relative_error {
         println!("relative error against the reference: {e:.3e}");
     }
+    // A 12- or 18-number reference is a Hamiltonian invariant, which the linear fit cannot
+    // give back (a relative error near 1 with no word why).
+    if let Some(reference) = reference.as_ref().filter(|_| !args.hamiltonian) {
+        if reference.numbers().len() > 6 {
+            println!(
+                "note: the reference is a Hamiltonian invariant ({} numbers); add --hamiltonian \
+                 to fit one",
+                reference.numbers().len()
+            );
+        }
+    }
     Ok(ExitCode::SUCCESS)
 }

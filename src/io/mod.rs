@@ -175,6 +175,15 @@ pub enum IoError {
         extension: Option<String>,
     },
 
+    /// The file extension does not name a mesh format that can be read.
+    #[error("{}: {}; liemesh reads meshes from files ending in .ply or .obj (letter case does not matter)", show(.path), describe_extension(.extension.as_deref()))]
+    UnreadableExtension {
+        /// The path whose extension was looked at.
+        path: PathBuf,
+        /// The extension found, without the dot; `None` if there was none.
+        extension: Option<String>,
+    },
+
     /// The format can be written but not read.
     #[error("{}: reading {format} files is not supported; liemesh reads .ply and .obj meshes, so export the mesh in one of those formats instead", show(.path))]
     ReadUnsupported {
@@ -251,6 +260,7 @@ impl IoError {
         match self {
             IoError::Io { path, .. }
             | IoError::UnsupportedExtension { path, .. }
+            | IoError::UnreadableExtension { path, .. }
             | IoError::ReadUnsupported { path, .. }
             | IoError::Parse { path, .. }
             | IoError::Truncated { path, .. }
@@ -266,6 +276,7 @@ impl IoError {
         match &mut self {
             IoError::Io { path, .. }
             | IoError::UnsupportedExtension { path, .. }
+            | IoError::UnreadableExtension { path, .. }
             | IoError::ReadUnsupported { path, .. }
             | IoError::Parse { path, .. }
             | IoError::Truncated { path, .. }
@@ -373,12 +384,18 @@ pub fn write_mesh(mesh: &Mesh, path: &Path, options: &WriteOptions) -> Result<()
 ///
 /// # Errors
 ///
-/// [`IoError::UnsupportedExtension`] or [`IoError::ReadUnsupported`] (STL)
+/// [`IoError::UnreadableExtension`] or [`IoError::ReadUnsupported`] (STL)
 /// for the path, [`IoError::Io`] if the file cannot be opened or read, and
 /// [`IoError::Parse`], [`IoError::Truncated`], [`IoError::IndexOutOfRange`]
 /// or [`IoError::NonFinite`] for bad content.
 pub fn read_mesh(path: &Path) -> Result<Mesh, IoError> {
-    let format = MeshFormat::from_path(path)?;
+    // The formats read are fewer than those written: an unknown extension names those.
+    let format = MeshFormat::from_path(path).map_err(|e| match e {
+        IoError::UnsupportedExtension { path, extension } => {
+            IoError::UnreadableExtension { path, extension }
+        }
+        e => e,
+    })?;
     if format == MeshFormat::Stl {
         return Err(IoError::ReadUnsupported {
             path: path.to_path_buf(),
@@ -638,6 +655,21 @@ mod tests {
             }
         ));
         assert!(err.to_string().contains("no extension"));
+    }
+
+    /// Reading names only the formats it reads (it said ".ply, .obj or .stl", and then
+    /// refused STL).
+    #[test]
+    fn reading_an_unknown_extension_lists_the_formats_read() {
+        let err = read_mesh(Path::new("invariant.toml")).unwrap_err();
+        assert!(
+            matches!(&err, IoError::UnreadableExtension { extension: Some(e), .. } if e == "toml")
+        );
+        let msg = err.to_string();
+        assert!(
+            msg.contains(".ply") && msg.contains(".obj") && !msg.contains(".stl"),
+            "{msg}"
+        );
     }
 
     #[test]
