@@ -485,7 +485,7 @@ fn publish<S: serde::Serialize>(args: &MeshArgs, report: &S) -> Result<(), CliEr
 }
 
 /// The derivatives `--derivative` asks for: one dual-number run per number, whose mesh must
-/// be the `f64` run's.
+/// be the `f64` run's; the arguments are as [`check_derivative_args`] allows.
 fn derivatives(
     args: &MeshArgs,
     invariant: &Invariant,
@@ -493,7 +493,7 @@ fn derivatives(
     mesh: &Mesh,
     status: &Status,
 ) -> Result<Vec<VertexDerivatives>, CliError> {
-    check_derivative_args(args, invariant)?;
+    // `run` checked the arguments (`check_derivative_args`) before meshing.
     let mut out = Vec::new();
     for &number in &args.derivative {
         // The 6 numbers of a linear invariant are the first row of the 18-number layout.
