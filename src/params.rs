@@ -151,9 +151,12 @@ pub struct MeshParams {
     pub dt: Option<f64>,
     /// Smallest step (steps are clamped to `[dt_min, dt_max]`); automatic: 10⁻³ step scales,
     /// or a quarter of `beta_min` (in radians) step scales when that is smaller (but a
-    /// five-hundredth of a given `dt_max` when that value is above it); on an
-    /// ellipsoid up to 16:1 ([`NormalField::semi_axes_through`]) also at most a quarter of
-    /// `beta_min` times its sharpest bend's radius. On a non-integrable field, whose sheet may
+    /// five-hundredth of a given `dt_max` when that value is above it); where that would turn
+    /// the normal at `p0` by more than a quarter of `beta_min` (a surface far from the
+    /// origin, whose `|p0|` is not its size), the same of the radius of curvature at `p0`
+    /// instead of the step scale; on an ellipsoid up to 20.5:1
+    /// ([`NormalField::semi_axes_through`]) also at most a quarter of `beta_min` times its
+    /// sharpest bend's radius. On a non-integrable field, whose sheet may
     /// run into a singular point of the field, up to 10⁻² step scales but at most 4·10⁻³
     /// extent scales.
     pub dt_min: Option<f64>,
@@ -540,7 +543,21 @@ impl MeshParams {
         );
         let dt_min = self.dt_min.unwrap_or_else(|| {
             let quarter_band = 0.25 * self.beta_min.radians();
-            let clamp = (AUTO_DT_MIN.min(quarter_band) * scales.step).min(quarter_band * sharpest);
+            let floor = AUTO_DT_MIN.min(quarter_band);
+            // The step scale's floor, an eighth of `|p0|`, stands for the size of a surface
+            // centred at the origin, which a field of one's own need not be: a unit sphere
+            // centred at (10⁶, 0, 0) had a step floor of 125, longer than the sphere, and
+            // every curve ended at its first step. Where the floor would turn the normal at
+            // `p0` itself by more than a quarter of β_min, `|p0|` is not the surface's size,
+            // and the floor is sized by the bend at `p0`, as it is for a surface round the
+            // origin whose step scale is its radius of curvature.
+            let rho = shape.radius_of_curvature();
+            let step = if floor * scales.step > quarter_band * rho {
+                rho
+            } else {
+                scales.step
+            };
+            let clamp = (floor * step).min(quarter_band * sharpest);
             let auto = if integrable {
                 clamp
             } else {

@@ -155,18 +155,22 @@ impl Surface {
     }
 }
 
-/// The field of a [`Surface`] scaled by `scale`: its gradient, or the gradient's direction
-/// (`unit`), which is not a gradient itself (the mesher weighs it by an integrating factor).
+/// The field of a [`Surface`] scaled by `scale` and moved by `offset`: its gradient, or the
+/// gradient's direction (`unit`), which is not a gradient itself (the mesher weighs it by an
+/// integrating factor).
 #[derive(Clone)]
 struct Scaled {
     surface: Surface,
     scale: f64,
+    offset: [f64; 3],
     unit: bool,
 }
 
 impl FieldFormula for Scaled {
     fn normal<T: Scalar>(&self, p: &Vec3<T>) -> Vec3<T> {
         let k = T::from_f64(1.0 / self.scale);
+        let o = |i: usize| T::from_f64(self.offset[i]);
+        let p = Vec3::new(p.x.clone() - o(0), p.y.clone() - o(1), p.z.clone() - o(2));
         let g = self.surface.value(&p.scale(&k)).1;
         if self.unit {
             let len = g.norm_squared().sqrt();
@@ -251,6 +255,7 @@ fn closed_user_surfaces_of_genus_zero_two_and_five_mesh_whole() {
             let field = Formula(Scaled {
                 surface,
                 scale,
+                offset: [0.0; 3],
                 unit,
             });
             let normals = if unit { "unit normals" } else { "gradient" };
@@ -323,6 +328,52 @@ fn closed_user_surfaces_of_genus_zero_two_and_five_mesh_whole() {
     );
 }
 
+/// A surface of one's own need not be centred at the origin. The automatic lengths take
+/// `|p0|` for the size of a surface centred there (the model's are), so far from the origin
+/// the step scale came out as an eighth of the distance and the step floor a thousandth of
+/// that: a unit sphere centred at (10⁶, 0, 0) had a floor of 125 and every curve ended at
+/// its first step ("only 1 sample point"), and at (10³, 0, 0) a floor of 0.125 left it
+/// coarser (1,502 triangles against 1,992). The floor now follows the bend at `p0` when
+/// `|p0|` cannot be the size. Moved 10³ and 10⁶ away, each surface meshes whole, as at the
+/// origin, to within a tenth of its triangles. (Rounding the offset away costs digits, six of
+/// sixteen at 10⁶: the superellipsoid's sharp edges then end a curve or two on the step
+/// floor, and it is moved 10³ only.)
+#[test]
+fn surfaces_far_from_the_origin_mesh_as_they_do_at_it() {
+    let direction = [0.36, -0.48, 0.8];
+    for (surface, distances) in [
+        (Surface::Blobs, &[1e3, 1e6][..]),
+        (Surface::DoubleTorus, &[1e3, 1e6][..]),
+        (Surface::Superellipsoid, &[1e3][..]),
+    ] {
+        let on = on_surface(surface, [0.6, 0.0, 0.8]).expect("the ray leaves");
+        let mut at_origin = None;
+        for &distance in std::iter::once(&0.0).chain(distances) {
+            let offset = direction.map(|x| x * distance);
+            let field = Formula(Scaled {
+                surface,
+                scale: 1.0,
+                offset,
+                unit: false,
+            });
+            let p0 = [0, 1, 2].map(|k| on[k] + offset[k]);
+            let what = format!("{surface:?} moved {distance:e} away, from {p0:?}");
+            let run = run::<f64, _>(&field, &MeshParams::at(p0))
+                .unwrap_or_else(|e| panic!("{what}: {e}"));
+            let v = &run.validation;
+            assert!(v.is_valid(), "{what}: {v}");
+            assert_eq!(v.genus(), Some(surface.genus()), "{what}: {v}");
+            assert!(run.cut_short().is_empty(), "{what}: {:?}", run.cut_short());
+            let triangles = run.mesh.triangles.len() as f64;
+            let reference = *at_origin.get_or_insert(triangles);
+            assert!(
+                (triangles / reference - 1.0).abs() <= 0.1,
+                "{what}: {triangles} triangles, {reference} at the origin"
+            );
+        }
+    }
+}
+
 /// Two tanglecubes (unit normals) whose last holes touched other holes at a vertex: the walk
 /// round the boundary took both holes as one loop through that vertex twice (or did not close
 /// round the second one until the first was filled), and the chart fill skipped them, leaving
@@ -346,6 +397,7 @@ fn tanglecube_holes_that_touch_at_a_vertex_are_filled() {
         let field = Formula(Scaled {
             surface: Surface::Tanglecube,
             scale,
+            offset: [0.0; 3],
             unit: true,
         });
         let run = run::<f64, _>(&field, &MeshParams::at(p0)).unwrap();
