@@ -185,13 +185,8 @@ impl MeshError {
     /// zero but its squared length is not a normal number, [`MeshError::BendAtInitialPoint`]
     /// when it gives a direction but no shape, [`MeshError::SingularInitialPoint`] otherwise.
     pub(crate) fn no_normal_at(p0: [f64; 3], normal: [f64; 3]) -> MeshError {
-        // |p0| without overflow in the squares.
-        let largest = p0.iter().fold(0.0f64, |m, x| m.max(x.abs()));
-        let size = if largest > 0.0 {
-            largest * p0.iter().map(|x| (x / largest).powi(2)).sum::<f64>().sqrt()
-        } else {
-            0.0
-        };
+        // |p0|, without overflow in the squares.
+        let size = p0[0].hypot(p0[1]).hypot(p0[2]);
         if size > crate::params::MAX_SURFACE_SIZE {
             return MeshError::SurfaceScale {
                 size,

@@ -552,12 +552,12 @@ impl MeshParams {
             // and the floor is sized by the bend at `p0`, as it is for a surface round the
             // origin whose step scale is its radius of curvature.
             let rho = shape.radius_of_curvature();
-            let step = if floor * scales.step > quarter_band * rho {
+            let floor_scale = if floor * scales.step > quarter_band * rho {
                 rho
             } else {
                 scales.step
             };
-            let clamp = (floor * step).min(quarter_band * sharpest);
+            let clamp = (floor * floor_scale).min(quarter_band * sharpest);
             let auto = if integrable {
                 clamp
             } else {

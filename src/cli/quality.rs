@@ -201,14 +201,12 @@ pub(super) fn recover_cmd(args: &RecoverArgs) -> Result<ExitCode, CliError> {
     }
     // A 12- or 18-number reference is a Hamiltonian invariant, which the linear fit cannot
     // give back (a relative error near 1 with no word why).
-    if let Some(reference) = reference.as_ref().filter(|_| !args.hamiltonian) {
-        if reference.numbers().len() > 6 {
-            println!(
-                "note: the reference is a Hamiltonian invariant ({} numbers); add --hamiltonian \
-                 to fit one",
-                reference.numbers().len()
-            );
-        }
+    let numbers = reference.as_ref().map_or(0, |r| r.numbers().len());
+    if numbers > 6 && !args.hamiltonian {
+        println!(
+            "note: the reference is a Hamiltonian invariant ({numbers} numbers); add \
+             --hamiltonian to fit one"
+        );
     }
     Ok(ExitCode::SUCCESS)
 }
