@@ -94,6 +94,38 @@ fn no_arguments_meshes_fig6_into_out() {
     assert!(dir.join("out/fig6.ply").exists());
 }
 
+/// The paper mode's explicit-Euler chords leave the surface (on a cone, past the apex onto
+/// a hyperboloid: x² + y² − z² from 0 to −0.1 at the far end): the summary says how far, and
+/// the drift-free default mode has no such line.
+#[test]
+fn the_paper_modes_drift_is_in_the_summary() {
+    let drift_line = |mode: &str| {
+        let o = liemesh()
+            .args([
+                "mesh",
+                "--invariant",
+                "examples/surfaces/cone.toml",
+                "--mode",
+                mode,
+            ])
+            .output()
+            .unwrap();
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        let text = String::from_utf8(o.stdout).unwrap();
+        text.lines()
+            .find(|l| l.trim_start().starts_with("drift"))
+            .map(str::to_string)
+    };
+    let paper = drift_line("paper").expect("the paper mode's summary names its drift");
+    let max: f64 = paper
+        .split_whitespace()
+        .nth(4)
+        .and_then(|x| x.parse().ok())
+        .unwrap_or_else(|| panic!("no number in {paper}"));
+    assert!(max > 1e-3 && max < 1.0, "{paper}");
+    assert_eq!(drift_line("default"), None);
+}
+
 #[test]
 fn bad_input_exits_2_with_a_one_line_message() {
     let dir = scratch("bad");

@@ -8,8 +8,9 @@ use liemesh::io::report::{FailureReport, Job, Report, VertexDerivatives};
 use liemesh::io::{self, WriteOptions};
 use liemesh::model::{AngleReading, Invariant, LieField};
 use liemesh::preset::Preset;
+use liemesh::quality::Drift;
 use liemesh::scalar::{Dual, Scalar, ScalarKind};
-use liemesh::{Mesh, MeshError, MeshParams};
+use liemesh::{Mesh, MeshError, MeshParams, Mode};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::time::Instant;
@@ -336,6 +337,10 @@ pub struct MeshOutcome {
     pub untangled: liemesh::triangulate::Untangled,
     /// The mesh's validation.
     pub validation: liemesh::mesh::Validation,
+    /// In the paper mode, how far the vertices drifted off `p0`'s level set (fields with a
+    /// known potential): its explicit-Euler chords leave the surface, on a cone past the
+    /// apex onto a hyperboloid, and the summary says by how much.
+    pub paper_drift: Option<liemesh::quality::Drift>,
 }
 
 impl MeshOutcome {
@@ -370,6 +375,12 @@ fn mesh_in<T: Scalar>(
         liemesh::quality::QualityReport::measure(invariant, params, &run.samples, &run.mesh)
     });
     let cut_short = run.cut_short();
+    let paper_drift = (params.mode == Mode::Paper)
+        .then(|| match &quality {
+            Some(q) => q.drift,
+            None => liemesh::quality::drift(invariant, &run.mesh, params.p0),
+        })
+        .flatten();
     Ok(MeshOutcome {
         curves: run.samples.curves.len(),
         curve_ends: run.samples.ends(),
@@ -382,6 +393,7 @@ fn mesh_in<T: Scalar>(
         stitched: run.stitched,
         untangled: run.untangled,
         validation: run.validation,
+        paper_drift,
     })
 }
 
@@ -465,7 +477,12 @@ pub(super) fn run(args: &MeshArgs) -> Result<ExitCode, CliError> {
     report.derivatives = derivatives;
     publish(args, &report)?;
     if !args.json && !args.quiet {
-        print_summary(&report, args.output.as_deref(), args.report.as_deref());
+        print_summary(
+            &report,
+            outcome.paper_drift,
+            args.output.as_deref(),
+            args.report.as_deref(),
+        );
     }
     Ok(ExitCode::SUCCESS)
 }
@@ -634,7 +651,12 @@ pub(super) fn write_json<S: serde::Serialize>(path: &Path, value: &S) -> Result<
     })
 }
 
-fn print_summary(r: &Report, mesh: Option<&Path>, report: Option<&Path>) {
+fn print_summary(
+    r: &Report,
+    paper_drift: Option<Drift>,
+    mesh: Option<&Path>,
+    report: Option<&Path>,
+) {
     let name = r.job.preset.as_deref().unwrap_or("invariant");
     println!("liemesh: {name} ({} scalars)", r.job.scalar);
     println!("  vertices   {}", r.vertices);
@@ -670,6 +692,14 @@ fn print_summary(r: &Report, mesh: Option<&Path>, report: Option<&Path>) {
         println!(
             "  untangled  {} relaxation moves taken back, {} crossing faces removed",
             r.untangled.reverted, r.untangled.removed
+        );
+    }
+    if let Some(d) = paper_drift {
+        println!(
+            "  drift      vertices up to {:.1e} of the mesh's diagonal off p0's level set (rms \
+             {:.1e}): the paper mode's explicit-Euler chords leave the surface; the default \
+             mode stays on it",
+            d.max, d.rms
         );
     }
     if !r.cut_short.is_empty() {
