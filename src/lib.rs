@@ -113,8 +113,11 @@ impl<T> MeshRun<T> {
         let mut why = Vec::new();
         if self.samples.hit_point_budget {
             why.push(format!(
-                "the point budget (max_points = {}) ran out",
-                p.max_points
+                "the point budget (max_points = {}) ran out before the geodesic radius \
+                 (max_radius = {:.3e}) or the bounding box (half-size {:.3e} about the origin) \
+                 stopped the curves; a larger max_points lets them go on, a smaller max_radius \
+                 makes the mesh smaller",
+                p.max_points, p.max_radius, p.bounding_box
             ));
         }
         if self.samples.curves.len() >= p.max_curves {
