@@ -340,7 +340,7 @@ pub struct MeshOutcome {
     /// In the paper mode, how far the vertices drifted off `p0`'s level set (fields with a
     /// known potential): its explicit-Euler chords leave the surface, on a cone past the
     /// apex onto a hyperboloid, and the summary says by how much.
-    pub paper_drift: Option<liemesh::quality::Drift>,
+    pub paper_drift: Option<Drift>,
 }
 
 impl MeshOutcome {
