@@ -337,10 +337,6 @@ pub struct MeshOutcome {
     pub untangled: liemesh::triangulate::Untangled,
     /// The mesh's validation.
     pub validation: liemesh::mesh::Validation,
-    /// In the paper mode, how far the vertices drifted off `p0`'s level set (fields with a
-    /// known potential): its explicit-Euler chords leave the surface, on a cone past the
-    /// apex onto a hyperboloid, and the summary says by how much.
-    pub paper_drift: Option<Drift>,
 }
 
 impl MeshOutcome {
@@ -375,12 +371,6 @@ fn mesh_in<T: Scalar>(
         liemesh::quality::QualityReport::measure(invariant, params, &run.samples, &run.mesh)
     });
     let cut_short = run.cut_short();
-    let paper_drift = (params.mode == Mode::Paper)
-        .then(|| match &quality {
-            Some(q) => q.drift,
-            None => liemesh::quality::drift(invariant, &run.mesh, params.p0),
-        })
-        .flatten();
     Ok(MeshOutcome {
         curves: run.samples.curves.len(),
         curve_ends: run.samples.ends(),
@@ -393,7 +383,6 @@ fn mesh_in<T: Scalar>(
         stitched: run.stitched,
         untangled: run.untangled,
         validation: run.validation,
-        paper_drift,
     })
 }
 
@@ -477,9 +466,17 @@ pub(super) fn run(args: &MeshArgs) -> Result<ExitCode, CliError> {
     report.derivatives = derivatives;
     publish(args, &report)?;
     if !args.json && !args.quiet {
+        // The paper mode's explicit-Euler chords leave the surface (a cone's run past the
+        // apex onto a hyperboloid): the summary says by how much, on fields with a potential.
+        let paper_drift = (params.mode == Mode::Paper)
+            .then(|| match &outcome.quality {
+                Some(q) => q.drift,
+                None => liemesh::quality::drift(&invariant, &outcome.mesh, params.p0),
+            })
+            .flatten();
         print_summary(
             &report,
-            outcome.paper_drift,
+            paper_drift,
             args.output.as_deref(),
             args.report.as_deref(),
         );

@@ -142,9 +142,8 @@ const EAR_CLEARANCE: f64 = 0.02;
 /// and says so, instead of running for minutes.
 const VISITS_PER_TRIANGLE: u64 = 400;
 /// The floor is what a mesh of tens of thousands of triangles may spend: a flared one-sheet
-/// hyperboloid (`λ = (25.1, 31.7, −227.6)`, posed, 11,854 triangles) needed 13.1M visits
-/// and was cut short at 11.5M with a floor of 2²³ (with no budget: 13.1M visits in a run
-/// of 0.85 s, the stitching's share of it included).
+/// hyperboloid (`λ = (25.1, 31.7, −227.6)`, posed, 11,854 triangles) was cut short at
+/// 11.5M visits with a floor of 2²³; without a budget it took 13.1M, in a run of 0.85 s.
 const VISITS_FLOOR: u64 = 1 << 25;
 /// Candidates examined per boundary edge: the nearest ones.
 const MAX_CANDIDATES: usize = 24;
