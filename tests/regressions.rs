@@ -1412,3 +1412,33 @@ fn a_refinement_that_cannot_converge_stops_and_says_so() {
         "{refinement:?}"
     );
 }
+
+/// The paper's literal eq. 2 with angles (`examples/surfaces/twisted-linear.toml`, a
+/// non-integrable field) from `p0` scaled by 10¹⁰, and with its `λ` scaled by 10¹⁰: the same
+/// surface, swept the same way. The integrability test divided the twist by `|v|² ‖J‖`, one
+/// power of `|v|` too many, so a field of magnitude 10¹⁰ passed for integrable and its sweep
+/// was stitched as a closed surface's fronts are: χ = −16 with two holes, and a stitching cut
+/// short by its budget.
+#[test]
+fn a_twisted_field_stays_a_sweep_at_any_scale() {
+    let numbers = [1.0, 4.0, 9.0, 0.3, 0.5, 0.7];
+    let p0 = [0.5, 0.3, 0.2];
+    let mesh = |numbers: [f64; 6], p0: [f64; 3]| {
+        let invariant = Invariant::from_numbers(&numbers).unwrap();
+        let run = liemesh::run(&LieField::<f64>::new(&invariant), &MeshParams::at(p0)).unwrap();
+        assert!(run.validation.is_valid(), "{}", run.validation);
+        assert!(run.cut_short().is_empty(), "{:?}", run.cut_short());
+        let v = &run.validation;
+        (
+            run.mesh.triangles.len(),
+            v.euler_characteristic,
+            v.boundary_loops,
+        )
+    };
+    let at_one = mesh(numbers, p0);
+    assert_eq!((at_one.1, at_one.2), (0, 2), "{at_one:?}");
+    let far = mesh(numbers, p0.map(|x| x * 1e10));
+    let strong = mesh([1e10, 4e10, 9e10, numbers[3], numbers[4], numbers[5]], p0);
+    assert_eq!(far, at_one);
+    assert_eq!(strong, at_one);
+}

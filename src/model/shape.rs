@@ -23,8 +23,9 @@ pub struct LocalShape {
     /// The principal curvatures (eigenvalues of the symmetric part of the shape operator
     /// `(I − n nᵀ) J_v / |v|` on the tangent plane), the larger in magnitude first.
     pub curvatures: [f64; 2],
-    /// `|v · (∇ × v)| / (|v|² ‖J_v‖)`: zero (to rounding) where the field is normal to a
-    /// family of surfaces (Frobenius), of order one where it is far from any.
+    /// `|v · (∇ × v)| / (|v| ‖J_v‖)`: zero (to rounding) where the field is normal to a
+    /// family of surfaces (Frobenius), of order one where it is far from any. Free of units:
+    /// the same for the field scaled by any factor and for the surface scaled about any point.
     pub integrability_defect: f64,
 }
 
@@ -61,8 +62,11 @@ impl LocalShape {
         let j = super::jacobian(field, &q).map(|row| row.to_f64());
         let curl = [j[2][1] - j[1][2], j[0][2] - j[2][0], j[1][0] - j[0][1]];
         let size = j.iter().map(|r| dot(*r, *r)).sum::<f64>().sqrt();
+        // `n · (∇ × n) = v · (∇ × v) / |v|²` is a curvature (one over a length); times the
+        // field's own length `|v| / ‖J‖` it is a number, so that neither a field scaled by
+        // 10¹⁰ nor a surface 10¹⁰ wide passes for integrable (a twist over `|v|²‖J‖` did).
         let integrability_defect = if size > 0.0 {
-            dot(v, curl).abs() / (len * len * size)
+            dot(v, curl).abs() / (len * size)
         } else {
             0.0
         };
@@ -229,6 +233,23 @@ mod tests {
         assert!(symmetric.expect("regular").integrability_defect < 1e-15);
         let literal = LocalShape::at::<f64, _>(&field(&[1.0, 4.0, 9.0, 0.3, 0.5, 0.7]), p);
         assert!(literal.expect("regular").integrability_defect > 1e-3);
+    }
+
+    #[test]
+    fn the_integrability_defect_does_not_depend_on_scale() {
+        let numbers = [1.0, 4.0, 9.0, 0.3, 0.5, 0.7];
+        let p = [0.3, -0.4, 0.5];
+        let defect = |numbers: [f64; 6], p: [f64; 3]| {
+            LocalShape::at::<f64, _>(&field(&numbers), p)
+                .expect("regular")
+                .integrability_defect
+        };
+        let at_one = defect(numbers, p);
+        let stronger = numbers.map(|x| x * 1e10);
+        let stronger = [stronger[0], stronger[1], stronger[2], 0.3, 0.5, 0.7];
+        for d in [defect(numbers, p.map(|x| x * 1e10)), defect(stronger, p)] {
+            assert!((d - at_one).abs() <= 1e-12 * at_one, "{d} against {at_one}");
+        }
     }
 
     #[test]
