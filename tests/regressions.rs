@@ -1442,3 +1442,48 @@ fn a_twisted_field_stays_a_sweep_at_any_scale() {
     assert_eq!(far, at_one);
     assert_eq!(strong, at_one);
 }
+
+/// A posed cone from `p0` and from `p0` scaled by 2⁻²⁰ (found by a new user's sweep of
+/// scales): every number of the run scales exactly, so the meshes must be the same up to
+/// that factor. spade's bulk load allows `f64::EPSILON` on squared lengths when it walks its
+/// hull, so on the chart 10⁻⁵ across it broke ties between cocircular points another way,
+/// and the small cone kept a 4-edge hole at its apex (χ = 0, 5,976 triangles against 5,510
+/// and χ = 1). Small charts are now scaled up by a power of two before spade sees them.
+#[test]
+fn a_cone_scaled_by_a_power_of_two_meshes_the_same() {
+    let invariant = Invariant::from_numbers(&[
+        -2.0831252220962706,
+        1.1507502326559789,
+        -1.5927438251276924,
+        1.495960747877633,
+        -0.1904495598900544,
+        1.439426934905657,
+    ])
+    .unwrap()
+    .with_reading(AngleReading::Quadric);
+    let field = LieField::<f64>::new(&invariant);
+    let p0 = [0.1915396169113766, 0.7976181186511364, 1.7337043941068515];
+    let at_one = liemesh::run(&field, &MeshParams::at(p0)).unwrap();
+    assert_eq!(
+        (
+            at_one.validation.euler_characteristic,
+            at_one.validation.boundary_loops
+        ),
+        (1, 1),
+        "{}",
+        at_one.validation
+    );
+    let s = 2f64.powi(-20);
+    let small = liemesh::run(&field, &MeshParams::at(p0.map(|x| x * s))).unwrap();
+    assert_eq!(small.mesh.triangles, at_one.mesh.triangles);
+    let scaled: Vec<[f64; 3]> = at_one
+        .mesh
+        .vertices
+        .iter()
+        .map(|v| v.map(|x| x * s))
+        .collect();
+    assert!(
+        small.mesh.vertices == scaled,
+        "the vertices differ by more than the scale"
+    );
+}
