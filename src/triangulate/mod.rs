@@ -700,10 +700,10 @@ fn chart_triangles(chart: &[[f64; 2]], front: &[u32]) -> Result<Vec<[u32; 3]>, M
     // spade takes coordinates between about 1e-43 and 1e60 in magnitude: a chart far outside
     // (a surface of size 1e-50 or 1e100) is scaled by a power of two, which changes no
     // predicate's sign; charts of ordinary size are handed over as they are. A small chart is
-    // scaled up too, to a span of 16–32 (as a surface of unit size has): spade's bulk load
-    // walks its hull with a test that allows `f64::EPSILON` on squared lengths, which on a
-    // chart 10⁻⁵ across breaks ties of cocircular points another way (a posed cone from `p0`
-    // scaled by 2⁻²⁰ kept a hole at its apex that it closes at unit size).
+    // scaled up too, to coordinates of 16–32 at most (as on a surface of unit size): spade's
+    // bulk load walks its hull with a test that allows `f64::EPSILON` on squared lengths,
+    // which on a chart 10⁻⁵ across breaks ties of cocircular points another way (a posed
+    // cone from `p0` scaled by 2⁻²⁰ kept a hole at its apex that it closes at unit size).
     let largest = chart.iter().flatten().fold(0.0_f64, |m, x| m.max(x.abs()));
     let unit = if largest > 0.0 && largest < 2f64.powi(-8) {
         2f64.powi(4 - largest.log2().floor() as i32)
