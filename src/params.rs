@@ -156,14 +156,17 @@ pub struct MeshParams {
     /// origin, whose `|p0|` is not its size), the same of the radius of curvature at `p0`
     /// instead of the step scale; on an ellipsoid up to 20.5:1
     /// ([`NormalField::semi_axes_through`]) also at most a quarter of `beta_min` times its
-    /// sharpest bend's radius. On a non-integrable field, whose sheet may
+    /// sharpest bend's radius, and from out on the flare of a band the field knows (farther
+    /// from its axis than the waist's widest radius) likewise of its waist's sharpest bend,
+    /// up to 6:1. On a non-integrable field, whose sheet may
     /// run into a singular point of the field, up to 10⁻² step scales but at most 4·10⁻³
     /// extent scales.
     pub dt_min: Option<f64>,
     /// Largest step; automatic: half the step scale, at most a twelfth of `max_radius`, and
-    /// on an ellipsoid up to 16:1 at most its shortest semi-axis, round a hole the field knows
-    /// ([`NormalField::hole_through`]) between half the waist's narrowest radius and all of
-    /// it.
+    /// on an ellipsoid up to 20.5:1 at most its shortest semi-axis; round a hole the field
+    /// knows ([`NormalField::hole_through`]) at least half the waist's narrowest radius, and
+    /// each step at most a quarter of the band's radius about the axis where it starts (but
+    /// not less than the waist's narrowest radius).
     pub dt_max: Option<f64>,
     /// β_min: smallest normal turn per step.
     #[cfg_attr(feature = "serde", serde(rename = "beta_min_deg"))]
@@ -183,7 +186,8 @@ pub struct MeshParams {
     /// other).
     pub merge: f64,
     /// Largest arc length from `p0` along a curve; automatic: 4π extent scales (π on a
-    /// non-integrable field).
+    /// non-integrable field); round a hole the field knows, the extent is at most `p0`'s
+    /// radius about the axis or the band's largest semi-axis, whichever is larger.
     pub max_radius: Option<f64>,
     /// Half-size of the axis-aligned box around the origin that points stay in; automatic: 6
     /// extent scales.
@@ -360,6 +364,12 @@ pub struct Resolved {
     /// field once, here (not in the serialised form).
     #[cfg_attr(feature = "serde", serde(skip))]
     pub hole: Option<Hole>,
+    /// Whether, round that hole and with `dt_max` automatic, no step is longer than a quarter
+    /// of the band's radius about the axis where it starts (and at least the waist's
+    /// narrowest radius, [`crate::trace::GIRTH_STEP`]): the steps then fit the band's girth along it, as it flares out (not in the
+    /// serialised form).
+    #[cfg_attr(feature = "serde", serde(skip))]
+    pub girth_steps: bool,
 }
 
 impl Resolved {
@@ -422,6 +432,12 @@ const AUTO_RADIUS: f64 = 4.0 * std::f64::consts::PI;
 /// itself within about this radius, and what lies beyond is laid only to be cut away.
 const AUTO_RADIUS_SWEPT: f64 = std::f64::consts::PI;
 const AUTO_BOX: f64 = 6.0;
+/// The flattest band (widest over narrowest semi-axis of its waist) whose automatic step floor
+/// lets curves follow its waist's sharpest bend (see [`MeshParams::resolve`]): elliptic
+/// cylinders up to about 6:1 come out whole from their flat side, flatter ones with that
+/// floor left holes in minutes of stitching (docs/status.md, forty-first session); they keep
+/// the floor of `p0` and end cut short on it.
+const BAND_FITTED_FLATNESS: f64 = 6.0;
 /// The automatic `dt_max` is at most the geodesic radius over this: a curve crosses the
 /// region it meshes in a dozen steps or more. Half the step scale alone can be as long as
 /// the region is wide where the surface is flat at `p0`: a Hamiltonian sweep with a radius
@@ -508,27 +524,55 @@ impl MeshParams {
         // Only up to FITTED_FLATNESS: flatter ones, meshed with isotropic triangles small
         // enough for the rim, run for tens of seconds into the stitching budget; they keep
         // the clamps of `p0` and end in an error that names `dt_max`, or cut short.
-        // Round a hole the field knows (a band's waist), no step longer than the waist's
-        // narrowest radius either: from a nearly flat flange of a 100:1 hyperboloid, steps
-        // sized at `p0` went round the waist in a hexagon. (Letting the steps shrink to the
-        // waist's bend as well took the curves through a 100:1 waist, where the fronts then
-        // met and left the flange a disc with a wedge open, instead of a band round the
-        // waist cut short there: docs/status.md.)
+        // Round a hole the field knows (a band's waist), no step longer than a quarter of the
+        // band's radius about its axis where the step starts, and at least the waist's
+        // narrowest radius (`Resolved::girth_steps`, `trace::GIRTH_STEP`): from a nearly flat flange of a 100:1 hyperboloid,
+        // steps sized at `p0` went round the waist in a hexagon, while a cap of the waist
+        // everywhere made a band started far out, where it is a hundred times wider, three
+        // million triangles of the waist's size. (Letting the steps shrink to the waist's
+        // bend as well took the curves through a 100:1 waist, where the fronts then met and
+        // left the flange a disc with a wedge open, instead of a band round the waist cut
+        // short there: docs/status.md.)
         let hole = field.hole_through(self.p0);
         let waist = hole.map(|h| h.waist());
+        // From out on a band's flare (`p0` farther from the axis than the waist's widest
+        // radius), steps may likewise shrink to the waist's sharpest bend (`narrowest² /
+        // widest`), which the band meshes too and the bend at `p0` does not tell: from 100
+        // up a hyperboloid 3.4:1 round its waist, 52 curves ended on a floor sized at `p0`.
+        // Only up to BAND_FITTED_FLATNESS, as elliptic cylinders flatter than that, met from
+        // their flat side, are not whole with any floor. (Within the waist's own girth the
+        // floor of `p0` stays: a thin 3:1 cylinder left a hole with this one.)
+        let band_bend = hole
+            .zip(field.size_through(self.p0))
+            .and_then(|(h, widest)| {
+                let narrowest = h.waist();
+                (h.radius_about(self.p0) > widest && widest <= BAND_FITTED_FLATNESS * narrowest)
+                    .then(|| narrowest * narrowest / widest)
+            });
         let (thickness, sharpest) = field
             .semi_axes_through(self.p0)
             .filter(|[s0, _, s2]| *s2 <= FITTED_FLATNESS * *s0)
             .map(|[s0, _, s2]| (s0, s0 * s0 / s2))
-            .or_else(|| Some((waist?, f64::INFINITY)))
-            .unwrap_or((f64::INFINITY, f64::INFINITY));
+            .unwrap_or((f64::INFINITY, band_bend.unwrap_or(f64::INFINITY)));
         let integrable = shape.is_integrable();
+        // A band is meshed round its axis as far as it is wide: the extent is at most p0's
+        // radius about the axis (or the band's largest semi-axis, if wider), not `|p0|`,
+        // which grows along the axis although the band does not: a unit cylinder from
+        // `(1, 0, 100)` was meshed out to a radius of 1,257 in 10⁶ triangles.
+        let reach = match hole {
+            Some(h) if integrable => {
+                let across = h.radius_about(self.p0);
+                let size = field.size_through(self.p0).unwrap_or(0.0);
+                scales.extent.min(across.max(size))
+            }
+            _ => scales.extent,
+        };
         let max_radius = self.max_radius.unwrap_or(
             if integrable {
                 AUTO_RADIUS
             } else {
                 AUTO_RADIUS_SWEPT
-            } * scales.extent,
+            } * reach,
         );
         // Round a hole, the girth sets the largest step as well as p0 does: at least what
         // a circular cylinder of the waist's radius would have. Near a sharp waist the step
@@ -596,6 +640,7 @@ impl MeshParams {
                 && !field.has_cubic_potential()
                 && has_curl_near(field, self.p0, scales.step),
             hole,
+            girth_steps: hole.is_some() && self.dt_max.is_none(),
         };
         resolved.check_lengths()?;
         Ok(resolved)

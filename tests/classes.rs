@@ -8,6 +8,7 @@
 //! | elliptic cylinders along any axis, in any pose | valid; a band (χ = 0, two boundary loops) in at least 95% of cases |
 //! | hyperboloids of one sheet, in any pose | valid; a band (χ = 0, two boundary loops) in at least 95% of cases |
 //! | flared hyperboloids of one sheet (flange 4:1 to 10:1 against the waist), in any pose, from the waist out onto the flange | valid, no face across the waist; a band, or the run says where it stopped short (a hole or a budget) |
+//! | elliptic cylinders and hyperboloids of one sheet, in any pose, from 10 to 300 times their size out along the axis | valid; a band (χ = 0, two boundary loops) in at least 95% of cases |
 //! | hyperboloids of two sheets, in any pose | valid, one sheet: a disc |
 //! | cones, in any pose | valid; one nappe (χ = 1 with one loop, or χ = 0 with two: meeting at or stopping short of the apex) in at least 95% of cases |
 //! | linear invariants with non-zero angles (non-integrable) | valid, at least 200 triangles; at most a fifth `MeshError::Empty` |
@@ -501,6 +502,47 @@ fn cones_are_one_nappe() {
     tolerating(BAND_MISSES, || {
         quadric_class(0xc0e, [1.0, 1.0, -1.0], 0.0, Shape::Nappe, "cone")
     });
+}
+
+/// Bands started far out along their axis, 10 to 300 times their size from the waist: the
+/// automatic extent and steps follow the band's width there, not `|p0|` (a unit cylinder
+/// from 100 up its axis was a million triangles, a hyperboloid from as far out ran into the
+/// point budget with holes).
+#[test]
+fn bands_from_far_along_their_axis_are_bands() {
+    tolerating(BAND_MISSES, far_bands);
+}
+
+fn far_bands() -> u32 {
+    let strategy = (
+        quadric_lambda(),
+        pose(),
+        0.0f64..std::f64::consts::TAU,
+        1.0f64..2.5,
+        prop::bool::ANY,
+    );
+    let mut runner = runner(0xfa5);
+    let cases = runner.config().cases;
+    runner
+        .run(&strategy, |((l, _, s), angles, phi, decades, cylinder)| {
+            let lambda = [l[0], l[1], if cylinder { 0.0 } else { -l[2] }];
+            // At height h up the axis, the point of the cross-section at angle phi.
+            let h = s * 10f64.powf(decades);
+            let across = lambda[0] * phi.cos().powi(2) + lambda[1] * phi.sin().powi(2);
+            let r = ((1.0 - lambda[2] * h * h) / across).sqrt();
+            let p0 = [r * phi.cos(), r * phi.sin(), h];
+            let rotation = rotation(angles);
+            let what = format!("far band λ {lambda:?} angles {angles:?}");
+            check(
+                &posed(lambda, angles),
+                apply_transposed(&rotation, p0),
+                Shape::Band,
+                &what,
+            )?;
+            Ok(())
+        })
+        .unwrap();
+    cases
 }
 
 /// Stitching a swept (non-integrable) surface joins what the curves swept; it never takes

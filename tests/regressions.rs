@@ -1487,3 +1487,42 @@ fn a_cone_scaled_by_a_power_of_two_meshes_the_same() {
         "the vertices differ by more than the scale"
     );
 }
+
+/// Bands started far along their axis (a new user's first points on a cylinder or a
+/// hyperboloid away from the waist). The automatic extent was `|p0|`, which grows along the
+/// axis although a cylinder does not: the unit cylinder from `(1, 0, 100)` was meshed out to
+/// a geodesic radius of 1,257, a million triangles. And no step was longer than the waist,
+/// however far out the band flared: the one-sheet hyperboloid `x² + y² − z² = 1` from 100
+/// away from its axis ran 188 s into the point budget (3·10⁶ triangles, holes). The extent of
+/// a band is now its radius about the axis at `p0`, and its steps fit its girth where they
+/// start.
+#[test]
+fn bands_started_far_along_their_axis_are_meshed_at_their_own_width() {
+    let band = |numbers: [f64; 6], p0: [f64; 3]| {
+        let invariant = Invariant::from_numbers(&numbers).unwrap();
+        let run = liemesh::run(&LieField::<f64>::new(&invariant), &MeshParams::at(p0)).unwrap();
+        assert!(run.validation.is_valid(), "{}", run.validation);
+        assert!(run.cut_short().is_empty(), "{:?}", run.cut_short());
+        let v = &run.validation;
+        assert_eq!((v.euler_characteristic, v.boundary_loops), (0, 2), "{v}");
+        run
+    };
+    // A cylinder from any height is the same band moved along its axis, round p0.
+    let cylinder = [1.0, 1.0, 0.0, 0.0, 0.0, 0.0];
+    let near = band(cylinder, [1.0, 0.0, 3.0]);
+    let far = band(cylinder, [1.0, 0.0, 100.0]);
+    assert_eq!(near.mesh.triangles.len(), far.mesh.triangles.len());
+    let reach = 4.0 * std::f64::consts::PI;
+    assert!(far
+        .mesh
+        .vertices
+        .iter()
+        .all(|p| (p[2] - 100.0).abs() <= reach));
+    // The hyperboloid from far out: its whole band, a few thousand triangles.
+    let hyperboloid = band(
+        [1.0, 1.0, -1.0, 0.0, 0.0, 0.0],
+        [100.0, 0.0, (100.0f64 * 100.0 - 1.0).sqrt()],
+    );
+    let triangles = hyperboloid.mesh.triangles.len();
+    assert!((1_000..20_000).contains(&triangles), "{triangles}");
+}

@@ -1,6 +1,7 @@
 //! Normal fields: what the mesher consumes.
 
 use super::invariant::{AngleReading, Invariant, Lift, Mat3};
+use crate::geom::vec3;
 use crate::scalar::{Dual, Scalar, Vec3};
 
 /// A normal field `v: R³ → R³` evaluated in the scalar type `T`.
@@ -180,6 +181,20 @@ impl Hole {
     /// The surface's narrowest radius about the axis.
     pub fn waist(&self) -> f64 {
         self.waist
+    }
+
+    /// The distance of `p` from the axis.
+    ///
+    /// ```
+    /// use liemesh::model::Hole;
+    /// let hole = Hole::new([[0.0; 3], [0.0, 0.0, 2.0]], 1.0).unwrap();
+    /// assert_eq!(hole.radius_about([3.0, 4.0, 100.0]), 5.0);
+    /// ```
+    pub fn radius_about(&self, p: [f64; 3]) -> f64 {
+        let [a, b] = self.axis;
+        let d = vec3::sub(b, a);
+        let c = vec3::cross(vec3::sub(p, a), d);
+        (vec3::dot(c, c) / vec3::dot(d, d)).sqrt()
     }
 }
 
