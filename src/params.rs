@@ -364,12 +364,6 @@ pub struct Resolved {
     /// field once, here (not in the serialised form).
     #[cfg_attr(feature = "serde", serde(skip))]
     pub hole: Option<Hole>,
-    /// Whether, round that hole and with `dt_max` automatic, no step is longer than a quarter
-    /// of the band's radius about the axis where it starts (and at least the waist's
-    /// narrowest radius, [`crate::trace::GIRTH_STEP`]): the steps then fit the band's girth along it, as it flares out (not in the
-    /// serialised form).
-    #[cfg_attr(feature = "serde", serde(skip))]
-    pub girth_steps: bool,
 }
 
 impl Resolved {
@@ -526,15 +520,17 @@ impl MeshParams {
         // the clamps of `p0` and end in an error that names `dt_max`, or cut short.
         // Round a hole the field knows (a band's waist), no step longer than a quarter of the
         // band's radius about its axis where the step starts, and at least the waist's
-        // narrowest radius (`Resolved::girth_steps`, `trace::GIRTH_STEP`): from a nearly flat flange of a 100:1 hyperboloid,
-        // steps sized at `p0` went round the waist in a hexagon, while a cap of the waist
-        // everywhere made a band started far out, where it is a hundred times wider, three
-        // million triangles of the waist's size. (Letting the steps shrink to the waist's
-        // bend as well took the curves through a 100:1 waist, where the fronts then met and
-        // left the flange a disc with a wedge open, instead of a band round the waist cut
-        // short there: docs/status.md.)
+        // narrowest radius (`trace::GIRTH_STEP`, with `dt_max` automatic): from a nearly flat
+        // flange of a 100:1 hyperboloid, steps sized at `p0` went round the waist in a
+        // hexagon, while a cap of the waist everywhere made a band started far out, where it
+        // is a hundred times wider, three million triangles of the waist's size. (Letting the
+        // steps shrink to the waist's bend as well took the curves through a 100:1 waist,
+        // where the fronts then met and left the flange a disc with a wedge open, instead of
+        // a band round the waist cut short there: docs/status.md.)
         let hole = field.hole_through(self.p0);
         let waist = hole.map(|h| h.waist());
+        // p0's radius about the band's axis and the band's widest semi-axis.
+        let band = hole.map(|h| (h.radius_about(self.p0), field.size_through(self.p0)));
         // From out on a band's flare (`p0` farther from the axis than the waist's widest
         // radius), steps may likewise shrink to the waist's sharpest bend (`narrowest² /
         // widest`), which the band meshes too and the bend at `p0` does not tell: from 100
@@ -542,13 +538,11 @@ impl MeshParams {
         // Only up to BAND_FITTED_FLATNESS, as elliptic cylinders flatter than that, met from
         // their flat side, are not whole with any floor. (Within the waist's own girth the
         // floor of `p0` stays: a thin 3:1 cylinder left a hole with this one.)
-        let band_bend = hole
-            .zip(field.size_through(self.p0))
-            .and_then(|(h, widest)| {
-                let narrowest = h.waist();
-                (h.radius_about(self.p0) > widest && widest <= BAND_FITTED_FLATNESS * narrowest)
-                    .then(|| narrowest * narrowest / widest)
-            });
+        let band_bend = waist.zip(band).and_then(|(narrowest, (across, widest))| {
+            let widest = widest?;
+            (across > widest && widest <= BAND_FITTED_FLATNESS * narrowest)
+                .then(|| narrowest * narrowest / widest)
+        });
         let (thickness, sharpest) = field
             .semi_axes_through(self.p0)
             .filter(|[s0, _, s2]| *s2 <= FITTED_FLATNESS * *s0)
@@ -559,11 +553,9 @@ impl MeshParams {
         // radius about the axis (or the band's largest semi-axis, if wider), not `|p0|`,
         // which grows along the axis although the band does not: a unit cylinder from
         // `(1, 0, 100)` was meshed out to a radius of 1,257 in 10⁶ triangles.
-        let reach = match hole {
-            Some(h) if integrable => {
-                let across = h.radius_about(self.p0);
-                let size = field.size_through(self.p0).unwrap_or(0.0);
-                scales.extent.min(across.max(size))
+        let reach = match band {
+            Some((across, widest)) if integrable => {
+                scales.extent.min(across.max(widest.unwrap_or(0.0)))
             }
             _ => scales.extent,
         };
@@ -640,7 +632,6 @@ impl MeshParams {
                 && !field.has_cubic_potential()
                 && has_curl_near(field, self.p0, scales.step),
             hole,
-            girth_steps: hole.is_some() && self.dt_max.is_none(),
         };
         resolved.check_lengths()?;
         Ok(resolved)

@@ -36,7 +36,8 @@ pub struct StepConfig<T> {
     integrating_factor: bool,
     /// Gauss–Legendre's rule for the rise of a potential along a chord ([`on_level`]).
     rise_rule: [(T, T); 5],
-    /// The hole of a band whose steps fit its girth ([`Resolved::girth_steps`]).
+    /// The hole of a band whose steps fit its girth ([`GIRTH_STEP`]): the field's, when
+    /// `dt_max` is automatic (a given one is every step's bound).
     girth: Option<crate::model::Hole>,
 }
 
@@ -80,7 +81,7 @@ impl<T: Scalar> StepConfig<T> {
             level_correction: params.level_correction,
             integrating_factor: params.integrating_factor,
             rise_rule: gauss_legendre_5(),
-            girth: params.hole.filter(|_| params.girth_steps),
+            girth: params.hole.filter(|_| params.given.dt_max.is_none()),
             overshoot_cos: {
                 let angle = OVERSHOOT * params.beta_max.radians();
                 if angle < std::f64::consts::PI {
