@@ -608,6 +608,37 @@ fn a_closure_stopped_at_a_sharp_bend_says_it_was_cut_short() {
     }
 }
 
+/// An elliptic cone (about 3:1 round its axis) from near its apex: one curve beside the
+/// apex found no chord to balance how fast the field turns there, and the run said it was
+/// cut short by a budget (INCOMPLETE), although the apex, a singular point, had ended it.
+/// Such an end is now asked, as an end on the step floor is, whether a zero of the field on
+/// the surface accounts for the bend. In a sweep of 60 random elliptic cones (up to 4:1,
+/// posed or not) 14 said INCOMPLETE so and none does now, every mesh byte-identical
+/// (docs/status.md, forty-sixth session).
+#[test]
+fn a_cone_curve_with_no_chord_beside_its_apex_ended_at_the_apex() {
+    let cone = Invariant::from_numbers(&[
+        8.222713814091021,
+        0.8666736608154115,
+        -0.166094909882914,
+        0.0,
+        0.0,
+        0.0,
+    ])
+    .unwrap();
+    let p0 = [
+        0.015284709755066538,
+        0.003782776636403864,
+        0.1078906891512405,
+    ];
+    let run = liemesh::run(&LieField::<f64>::new(&cone), &MeshParams::at(p0)).unwrap();
+    let ends = run.samples.ends();
+    assert!(run.validation.is_valid(), "{}", run.validation);
+    assert!(ends.singular > 0, "{ends:?}");
+    assert_eq!(ends.budget, 0, "{ends:?}");
+    assert!(run.cut_short().is_empty(), "{:?}", run.cut_short());
+}
+
 /// Unit normals are how many write a surface's field, and they are not a gradient: the
 /// ellipsoid `x² + 4 y² + 16 z² = 1` given by `∇F / |∇F|` was meshed with vertices up to
 /// 2.3·10⁻⁴–1.0·10⁻³ off it (its raw gradient: 10⁻¹⁵), because a chord's level correction

@@ -37,10 +37,12 @@ pub enum CurveEnd {
     /// Came too close to a neighbouring curve (proposed method).
     Merge,
     /// Met a singular point (vanishing normal, no tangent direction, non-finite value), or
-    /// the step floor `dt_min` where the surface may have one (a cone's apex).
+    /// the step floor `dt_min` where the surface may have one (a cone's apex), or no chord
+    /// ([`StepStop::NoChord`](crate::trace::StepStop::NoChord)) beside one.
     Singular,
     /// A budget ran out: points, steps per curve, Newton's iterations for a chord at every
-    /// length tried ([`StepStop::NoChord`](crate::trace::StepStop::NoChord)), or the step
+    /// length tried ([`StepStop::NoChord`](crate::trace::StepStop::NoChord)) where no
+    /// singular point accounts for the bend, or the step
     /// floor `dt_min` at a bend with no singular point: on a surface known to have none
     /// ([`NormalField::is_regular_through`]: an ellipsoid's rim or a flared hyperboloid's
     /// waist bending more sharply than that step can follow), or, on a field integrable at
@@ -413,6 +415,17 @@ struct Sampler<'a, T, F> {
 }
 
 impl<T: Scalar, F: NormalField<T>> Sampler<'_, T, F> {
+    /// Whether the surface's bend at `p` is a singular point's doing: a zero of the field on
+    /// the level set within a few dozen radii of curvature ([`bend_has_singular_point`]), on
+    /// a field integrable at `p0` that does not know its surface to be regular.
+    fn beside_singular_point(&self, p: [f64; 3]) -> bool {
+        !self.no_singular_point
+            && self.level_set
+            && LocalShape::at::<T, F>(self.field, p).is_some_and(|shape| {
+                bend_has_singular_point(self.field, p, shape.radius_of_curvature())
+            })
+    }
+
     /// The heap key of a curve at arc length `s` (see [`ORDER_RESOLUTION`]).
     fn order_key(&self, s: f64) -> u64 {
         (s * ORDER_RESOLUTION / self.params.dt_min).floor() as u64
@@ -478,7 +491,16 @@ impl<T: Scalar, F: NormalField<T>> Sampler<'_, T, F> {
         let live = &self.live[ci];
         let step = match trace::step(self.field, &self.cfg, &live.p, &live.carry, &live.dt) {
             Ok(s) => s,
-            Err(trace::StepStop::NoChord) => return Some(CurveEnd::Budget),
+            // No chord balances how fast the field turns over even the shortest step: beside
+            // a singular point of the surface (a cone's apex) that is the point's doing, as
+            // at the step floor below; elsewhere a budget ended the curve.
+            Err(trace::StepStop::NoChord) => {
+                return Some(if self.beside_singular_point(live.p.to_f64()) {
+                    CurveEnd::Singular
+                } else {
+                    CurveEnd::Budget
+                });
+            }
             Err(_) => return Some(CurveEnd::Singular),
         };
         let len = step.dt.to_f64();
