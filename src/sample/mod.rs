@@ -415,15 +415,13 @@ struct Sampler<'a, T, F> {
 }
 
 impl<T: Scalar, F: NormalField<T>> Sampler<'_, T, F> {
-    /// Whether the surface's bend at `p` is a singular point's doing: a zero of the field on
-    /// the level set within a few dozen radii of curvature ([`bend_has_singular_point`]), on
-    /// a field integrable at `p0` that does not know its surface to be regular.
-    fn beside_singular_point(&self, p: [f64; 3]) -> bool {
+    /// Whether a bend of radius `radius` at `p` that no step can follow ends its curve as at a
+    /// singular point rather than on a budget: not on a surface known to have none; on a
+    /// field integrable at `p0`, only where a zero of the field on the level set accounts for
+    /// the bend ([`bend_has_singular_point`]; a cone's apex); on any other field, always.
+    fn singular_bend(&self, p: [f64; 3], radius: f64) -> bool {
         !self.no_singular_point
-            && self.level_set
-            && LocalShape::at::<T, F>(self.field, p).is_some_and(|shape| {
-                bend_has_singular_point(self.field, p, shape.radius_of_curvature())
-            })
+            && (!self.level_set || bend_has_singular_point(self.field, p, radius))
     }
 
     /// The heap key of a curve at arc length `s` (see [`ORDER_RESOLUTION`]).
@@ -494,8 +492,13 @@ impl<T: Scalar, F: NormalField<T>> Sampler<'_, T, F> {
             // No chord balances how fast the field turns over even the shortest step: beside
             // a singular point of the surface (a cone's apex) that is the point's doing, as
             // at the step floor below; elsewhere a budget ended the curve.
+            // (On a field not integrable at `p0` nothing tells, and a budget it is.)
             Err(trace::StepStop::NoChord) => {
-                return Some(if self.beside_singular_point(live.p.to_f64()) {
+                let p = live.p.to_f64();
+                let singular = self.level_set
+                    && LocalShape::at::<T, F>(self.field, p)
+                        .is_some_and(|shape| self.singular_bend(p, shape.radius_of_curvature()));
+                return Some(if singular {
                     CurveEnd::Singular
                 } else {
                     CurveEnd::Budget
@@ -516,17 +519,11 @@ impl<T: Scalar, F: NormalField<T>> Sampler<'_, T, F> {
             && len <= self.params.dt_min * (1.0 + 1e-9)
             && step.alpha_predicted > SINGULAR_TURN * self.params.beta_max.radians()
         {
-            let regular = self.no_singular_point
-                || (self.level_set
-                    && !bend_has_singular_point(
-                        self.field,
-                        live.p.to_f64(),
-                        len / step.alpha_predicted,
-                    ));
-            return Some(if regular {
-                CurveEnd::Budget
-            } else {
+            let singular = self.singular_bend(live.p.to_f64(), len / step.alpha_predicted);
+            return Some(if singular {
                 CurveEnd::Singular
+            } else {
+                CurveEnd::Budget
             });
         }
         let s_new = live.s + len;
