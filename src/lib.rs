@@ -337,8 +337,11 @@ pub fn run_observed<T: Scalar, F: NormalField<T>>(
     // samples on the rare run that needs it rather than copied on every run (a copy of the
     // whole mesh held through relaxation and validation: 48 MB at 10⁶ triangles).
     let before_relaxation = || {
-        let (mesh, _, working, _) =
+        let (mut mesh, _, working, _) =
             assemble(field, params, &samples, improve, axis, &|_| {}).ok()?;
+        // Without the faces peeled off beside a singular point below, should untangling go
+        // back to these triangles.
+        triangulate::peel_faces_beside_singular_points(field, &samples, &mut mesh);
         Some(triangulate::Before {
             positions: mesh.vertices,
             normals: mesh.normals,
@@ -381,6 +384,9 @@ pub fn run_observed<T: Scalar, F: NormalField<T>>(
     // No face may span the hole the field knows: the stitching and the flips hold to that,
     // and a face that relaxation or refinement carried across it goes here.
     let across = triangulate::drop_across(&mut mesh, axis);
+    // Faces far off the surface beside a cone's apex are peeled off the boundary, at the
+    // vertices' final places.
+    let peeled = triangulate::peel_faces_beside_singular_points(field, &samples, &mut mesh);
     // Pinched vertices are cut apart and only the main component is kept. The validation
     // finds both (and the faces it leaves out of its topology, which those passes may drop),
     // so on the usual mesh, which has none of them, the passes are skipped.
@@ -422,6 +428,7 @@ pub fn run_observed<T: Scalar, F: NormalField<T>>(
     }
     untangled.pinned = pinned;
     untangled.removed += across;
+    untangled.off_surface = peeled;
     let mut stitched = stitched;
     stitched.holes = triangulate::holes(&samples, params, &mesh, &boundary, axis);
     triangulate::drop_unused(&mut mesh, &mut vertices);

@@ -691,6 +691,15 @@ fn print_summary(
             r.untangled.reverted, r.untangled.removed
         );
     }
+    let off = r.untangled.off_surface;
+    if off > 0 {
+        println!(
+            "  singular   {off} face{} more than {}° off the surface beside a singular point \
+             removed: the mesh stops short of it there",
+            if off == 1 { "" } else { "s" },
+            liemesh::triangulate::SINGULAR_FAN_DEG
+        );
+    }
     if let Some(d) = paper_drift {
         println!(
             "  drift      vertices up to {:.1e} of the mesh's diagonal off p0's level set (rms \

@@ -339,6 +339,105 @@ pub(crate) fn drop_across(mesh: &mut Mesh, axis: Option<[[f64; 3]; 2]>) -> usize
     before - mesh.triangles.len()
 }
 
+/// Faces beside a singular point are peeled off the mesh's boundary while they stand further
+/// than this off the surface (the field's normal at their centroid).
+///
+/// Curves end at different distances from a cone's apex (one step floor, a sharper bend on an
+/// elliptic cone's narrow side), and a curve that went on past such an end, nearer the apex,
+/// is joined to it by a fan of long faces across the sharply bending surface between them,
+/// 60° to 116° off it on random elliptic cones; two curves that run into the apex side by side
+/// can be joined by such a strip too. The mesh stops short of the apex there instead.
+/// Elsewhere faces stand a few degrees off (a step turns the normal by at most `β_max`).
+pub const SINGULAR_FAN_DEG: f64 = 40.0;
+
+/// Removes the faces of `mesh` that stand further than [`SINGULAR_FAN_DEG`] off the surface,
+/// have a corner on a curve of `samples` that ended at a singular point, and have a corner on
+/// the boundary, again and again while the removals bring more of them to the boundary;
+/// returns how many. Faces inside the mesh stay (taking them would open a hole). Nothing is
+/// evaluated when no curve ended at a singular point.
+pub(crate) fn peel_faces_beside_singular_points<T: Scalar, F: NormalField<T>>(
+    field: &F,
+    samples: &Samples<T>,
+    mesh: &mut Mesh,
+) -> usize {
+    let on_singular_curve: Vec<bool> = mesh
+        .provenance
+        .iter()
+        .map(|pr| {
+            samples
+                .curves
+                .get(pr.curve as usize)
+                .is_some_and(|c| c.end == CurveEnd::Singular)
+        })
+        .collect();
+    if !on_singular_curve.contains(&true) {
+        return 0;
+    }
+    let fast = field.in_f64();
+    let normal_at = |c: &Vec3<f64>| match fast {
+        Some(f) => f.normal(c),
+        None => Vec3::from_f64(field.normal(&Vec3::<T>::from_f64(c.to_f64())).to_f64()),
+    };
+    let p = &mesh.vertices;
+    let off: Vec<usize> = (0..mesh.triangles.len())
+        .filter(|&f| {
+            let t = mesh.triangles[f];
+            t.iter().any(|&v| on_singular_curve[v as usize])
+                && crate::geom::face_error_deg(t.map(|v| p[v as usize]), normal_at)
+                    > SINGULAR_FAN_DEG
+        })
+        .collect();
+    if off.is_empty() {
+        return 0;
+    }
+    // Each vertex's faces; a vertex is on the boundary where one of its directed edges `v → u`
+    // among its live faces has no `u → v` beside it.
+    let tris = &mesh.triangles;
+    let Some((start, faces)) = crate::geom::rows::rows_by_corner(tris, p.len(), |t, _| t as u32)
+    else {
+        return 0;
+    };
+    let mut gone = vec![false; tris.len()];
+    let on_boundary = |v: u32, gone: &[bool]| {
+        let star = || {
+            faces[start[v as usize] as usize..start[v as usize + 1] as usize]
+                .iter()
+                .filter(|&&f| !gone[f as usize])
+                .map(|&f| tris[f as usize])
+        };
+        let next = |t: [u32; 3]| t[(t.iter().position(|&x| x == v).unwrap_or(0) + 1) % 3];
+        let prev = |t: [u32; 3]| t[(t.iter().position(|&x| x == v).unwrap_or(0) + 2) % 3];
+        star().any(|t| !star().any(|o| prev(o) == next(t)))
+            || star().any(|t| !star().any(|o| next(o) == prev(t)))
+    };
+    // A face is checked again only when a face at one of its corners goes (the only way its
+    // corners can come to the boundary); what is peeled does not depend on the order.
+    let mut is_off = vec![false; tris.len()];
+    for &f in &off {
+        is_off[f] = true;
+    }
+    let mut removed = 0;
+    let mut stack = off;
+    while let Some(f) = stack.pop() {
+        if gone[f] || !tris[f].iter().any(|&v| on_boundary(v, &gone)) {
+            continue;
+        }
+        gone[f] = true;
+        removed += 1;
+        for v in tris[f] {
+            let star = &faces[start[v as usize] as usize..start[v as usize + 1] as usize];
+            stack.extend(
+                star.iter()
+                    .map(|&g| g as usize)
+                    .filter(|&g| is_off[g] && !gone[g]),
+            );
+        }
+    }
+    let mut gone = gone.into_iter();
+    mesh.triangles.retain(|_| !gone.next().unwrap_or(false));
+    removed
+}
+
 /// [`stitch`] once the chart's triangles across `axis` are gone.
 fn stitch_chart<T: Scalar, F: NormalField<T>>(
     field: &F,
