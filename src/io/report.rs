@@ -83,7 +83,8 @@ pub struct Report {
     /// What stitching where fronts met did.
     #[cfg_attr(feature = "serde", serde(default))]
     pub stitched: crate::triangulate::Stitched,
-    /// What was undone so that the mesh does not cross itself.
+    /// What was undone so that the mesh does not cross itself, nor stand far off the surface
+    /// beside a singular point.
     #[cfg_attr(feature = "serde", serde(default))]
     pub untangled: crate::triangulate::Untangled,
     /// The exact validation of the mesh written.
