@@ -42,10 +42,10 @@ pub struct Untangled {
     /// Faces removed because they crossed others, or were cut off with them, or met the axis
     /// of the surface's hole ([`crate::model::Hole`]).
     pub removed: usize,
-    /// Faces removed, before relaxation, because they stood further than
-    /// [`SINGULAR_FAN_DEG`](crate::triangulate::SINGULAR_FAN_DEG) off the surface at a corner
-    /// where a curve ended at a singular point (a fan towards a cone's apex): the mesh stops
-    /// short of the singular point there.
+    /// Faces peeled off the boundary because they stood further than
+    /// [`SINGULAR_FAN_DEG`](crate::triangulate::SINGULAR_FAN_DEG) off the surface with a corner
+    /// on a curve that ended at a singular point (a fan or strip towards a cone's apex): the
+    /// mesh stops short of the singular point there.
     #[cfg_attr(feature = "serde", serde(default))]
     pub off_surface: usize,
     /// Crossing face pairs left (0 unless the rounds ran out).
