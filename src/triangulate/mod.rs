@@ -23,7 +23,7 @@ mod relax;
 mod stitch;
 mod untangle;
 
-pub(crate) use refine::{faces_over, refine};
+pub(crate) use refine::{f64_normal, faces_over, refine};
 pub use refine::{Refinement, MAX_REFINE_ROUNDS};
 pub(crate) use relax::relax;
 pub(crate) use stitch::unpinch;
@@ -360,6 +360,9 @@ pub(crate) fn peel_faces_beside_singular_points<T: Scalar, F: NormalField<T>>(
     samples: &Samples<T>,
     mesh: &mut Mesh,
 ) -> usize {
+    if !samples.curves.iter().any(|c| c.end == CurveEnd::Singular) {
+        return 0;
+    }
     let on_singular_curve: Vec<bool> = mesh
         .provenance
         .iter()
@@ -370,14 +373,7 @@ pub(crate) fn peel_faces_beside_singular_points<T: Scalar, F: NormalField<T>>(
                 .is_some_and(|c| c.end == CurveEnd::Singular)
         })
         .collect();
-    if !on_singular_curve.contains(&true) {
-        return 0;
-    }
-    let fast = field.in_f64();
-    let normal_at = |c: &Vec3<f64>| match fast {
-        Some(f) => f.normal(c),
-        None => Vec3::from_f64(field.normal(&Vec3::<T>::from_f64(c.to_f64())).to_f64()),
-    };
+    let normal_at = f64_normal(field);
     let p = &mesh.vertices;
     let off: Vec<usize> = (0..mesh.triangles.len())
         .filter(|&f| {

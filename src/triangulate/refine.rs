@@ -82,6 +82,19 @@ pub struct Refinement {
     pub stalled: bool,
 }
 
+/// The field's normal at an `f64` point, as the quality report measures faces: a field in a
+/// wider type evaluates its own `f64` rounding where it has one
+/// ([`NormalField::in_f64`]).
+pub(crate) fn f64_normal<T: Scalar, F: NormalField<T>>(
+    field: &F,
+) -> impl Fn(&Vec3<f64>) -> Vec3<f64> + Copy + '_ {
+    let fast = field.in_f64();
+    move |c: &Vec3<f64>| match fast {
+        Some(f) => f.normal(c),
+        None => Vec3::from_f64(field.normal(&Vec3::<T>::from_f64(c.to_f64())).to_f64()),
+    }
+}
+
 /// How many faces of `mesh` have a normal error above `limit_deg`, measured as [`refine`]
 /// measures it (faces removed after refinement, when crossings are undone, no longer count).
 pub(crate) fn faces_over<T: Scalar, F: NormalField<T>>(
@@ -89,11 +102,7 @@ pub(crate) fn faces_over<T: Scalar, F: NormalField<T>>(
     mesh: &Mesh,
     limit_deg: f64,
 ) -> usize {
-    let fast = field.in_f64();
-    let normal_at = |c: &Vec3<f64>| match fast {
-        Some(f) => f.normal(c),
-        None => Vec3::from_f64(field.normal(&Vec3::<T>::from_f64(c.to_f64())).to_f64()),
-    };
+    let normal_at = f64_normal(field);
     par::map(mesh.triangles.len(), par::MIN_COSTLY, |t| {
         face_error_deg(
             mesh.triangles[t].map(|i| mesh.vertices[i as usize]),
@@ -121,11 +130,7 @@ pub(crate) fn refine<T: Scalar, F: NormalField<T>>(
     let cfg = StepConfig::<T>::new(params);
     // The error is measured on the `f64` mesh, as the quality report measures it; a field in
     // a wider type evaluates its own `f64` rounding where it has one.
-    let fast = field.in_f64();
-    let normal_at = |c: &Vec3<f64>| match fast {
-        Some(f) => f.normal(c),
-        None => Vec3::from_f64(field.normal(&Vec3::<T>::from_f64(c.to_f64())).to_f64()),
-    };
+    let normal_at = f64_normal(field);
     let error = |vertices: &[[f64; 3]], tri: [u32; 3]| {
         face_error_deg(tri.map(|i| vertices[i as usize]), normal_at)
     };
