@@ -1622,3 +1622,28 @@ fn faces_off_a_cone_beside_its_apex_are_peeled_off() {
         );
     }
 }
+
+/// Found by a new user's sweep of the options: the six curves of the proposed method's fan
+/// leave p0 sin 60° ≈ 0.87 of a step from one another's lines, so any merge threshold between
+/// that and gap/2 (an allowed value) ended all of them but one at their first step, and the
+/// run failed with "no triangle of the 59 sample points survived validation".
+#[test]
+fn a_merge_threshold_up_to_half_the_gap_leaves_the_fan_at_p0_alone() {
+    for (gap, merge) in [(1.8, 0.87), (1.8, 0.89), (4.0, 1.95), (10.0, 4.9)] {
+        let mut params = Preset::Fig3.params();
+        (params.gap, params.merge) = (gap, merge);
+        let run = liemesh::run(&sphere(), &params)
+            .unwrap_or_else(|e| panic!("gap {gap}, merge {merge}: {e}"));
+        let v = &run.validation;
+        assert!(
+            v.is_closed() && v.euler_characteristic == 2,
+            "gap {gap}, merge {merge}: {v}"
+        );
+        assert!(
+            run.mesh.triangles.len() >= 250,
+            "gap {gap}, merge {merge}: {} triangles",
+            run.mesh.triangles.len()
+        );
+    }
+}
+

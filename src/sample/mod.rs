@@ -212,6 +212,9 @@ fn squared_bound_beyond(limit: f64) -> f64 {
     }
 }
 
+/// No curve: a neighbour not yet known.
+const NO_CURVE: u32 = u32::MAX;
+
 /// Steps a curve waits before inserting on a side again after a curve it inserted there
 /// merged at once.
 const COOLDOWN_STEPS: f64 = 4.0;
@@ -265,6 +268,10 @@ struct Live<T> {
     cooldown: [f64; 2],
     /// For an inserted curve: its parent and whether it lies on the parent's right.
     inserted_from: Option<(u32, bool)>,
+    /// The neighbour on the right (0) and left (1) at the last step and the lateral gap to it
+    /// then (measured only while merging is on): curves of the fan do not merge while they
+    /// move apart.
+    last_gap: [(u32, f64); 2],
 }
 
 /// Samples the surface of `field` from `params.p0` (paper Steps 2–7).
@@ -365,6 +372,8 @@ pub(crate) fn sample_resolved<T: Scalar, F: NormalField<T>>(
             chart_dir: [theta.cos(), theta.sin()],
             cooldown: [0.0; 2],
             inserted_from: None,
+            // Every curve of the fan starts at p0, no gap from its neighbours.
+            last_gap: [((j + 1) % n, 0.0), ((j + n - 1) % n, 0.0)],
         });
         s.heap.push(Reverse((s.order_key(0.0), j)));
     }
@@ -556,11 +565,24 @@ impl<T: Scalar, F: NormalField<T>> Sampler<'_, T, F> {
         }
         let proposed = self.params.method == Method::Proposed;
         let (left, right) = (live.left, live.right);
+        let mut gaps = [(NO_CURVE, f64::INFINITY); 2];
         if proposed && self.params.merge > 0.0 {
-            for k in [right, left] {
-                if k != c && self.lateral_gap(k, q).0 < self.params.merge * len {
+            for (side, k) in [right, left].into_iter().enumerate() {
+                if k == c {
+                    continue;
+                }
+                let gap = self.lateral_gap(k, q).0;
+                // Two curves of the fan at p0 do not merge while they move apart: they leave
+                // p0 sin 60° ≈ 0.87 of a step from each other's lines, and a merge threshold
+                // up to gap/2 would end all but one there. (Other curves merge as they did.)
+                let (was, before) = self.live[ci].last_gap[side];
+                let fan = self.live[ci].inserted_from.is_none()
+                    && self.live[k as usize].inserted_from.is_none();
+                let apart = fan && was == k && gap > before;
+                if gap < self.params.merge * len && !apart {
                     return Some(CurveEnd::Merge);
                 }
+                gaps[side] = (k, gap);
             }
         }
 
@@ -590,6 +612,7 @@ impl<T: Scalar, F: NormalField<T>> Sampler<'_, T, F> {
             self.max_drift = self.max_drift.max(drift);
         }
         let live = &mut self.live[ci];
+        live.last_gap = gaps;
         live.drift = drift;
         live.p = step.point;
         live.carry = step.carry;
@@ -929,6 +952,7 @@ impl<T: Scalar, F: NormalField<T>> Sampler<'_, T, F> {
             chart_dir,
             cooldown: [0.0; 2],
             inserted_from: Some((c, k_is_right)),
+            last_gap: [(NO_CURVE, f64::INFINITY); 2],
         });
         self.live[left as usize].right = id;
         self.live[right as usize].left = id;
