@@ -294,7 +294,9 @@ impl<T: Scalar> LieField<T> {
         }
         let a: [[f64; 3]; 3] = std::array::from_fn(|i| self.a[i].to_f64());
         let scale = a.iter().flatten().fold(0.0_f64, |m, x| m.max(x.abs()));
-        let symmetric = (0..3).all(|i| (0..i).all(|j| (a[i][j] - a[j][i]).abs() <= 1e-12 * scale));
+        let tolerance = rounding_of::<T>();
+        let symmetric =
+            (0..3).all(|i| (0..i).all(|j| (a[i][j] - a[j][i]).abs() <= tolerance * scale));
         if !(symmetric && scale.is_finite() && scale > 0.0) {
             return None;
         }
@@ -303,8 +305,25 @@ impl<T: Scalar> LieField<T> {
         let c = p.dot(&(m * p));
         let eigen = nalgebra::SymmetricEigen::new(m);
         let vectors = [0, 1, 2].map(|k| [0, 1, 2].map(|i| eigen.eigenvectors[(i, k)]));
-        Some(([0, 1, 2].map(|k| eigen.eigenvalues[k]), vectors, c))
+        // An eigenvalue within the rounding of `A` is zero: a cylinder turned in `f32` has
+        // one of 10⁻⁸, which made it a band 10⁴ wide, sized by that "semi-axis".
+        let eigenvalues = [0, 1, 2].map(|k| {
+            let l = eigen.eigenvalues[k];
+            if l.abs() <= tolerance {
+                0.0
+            } else {
+                l
+            }
+        });
+        Some((eigenvalues, vectors, c))
     }
+}
+
+/// How far rounding in the scalar `T` may have moved `A`'s entries and eigenvalues, relative
+/// to its largest entry: the field builds `A` in `T`, so an `f32` field's turned cylinder has
+/// an eigenvalue of 10⁻⁸ where it should have 0. Never below `10⁻¹²` (`f64`'s).
+fn rounding_of<T: Scalar>() -> f64 {
+    (64.0 * T::unit_roundoff()).max(1e-12)
 }
 
 /// A quadric's level `c` (for `A` scaled to entries of at most one) counts as clear of zero
@@ -314,8 +333,11 @@ const REGULAR_LEVEL: f64 = 1e-9;
 
 /// Whether a quadric's level `c` through `p0` (of `A` scaled to entries of at most one, so
 /// that `|c| ≤ 3 |p0|²`) is clear of zero: not a cone, whose `p0` gives a `c` of rounding size.
-fn clear_of_zero(c: f64, p0: [f64; 3]) -> bool {
-    c.abs() > REGULAR_LEVEL * p0.iter().map(|x| x * x).sum::<f64>()
+/// In a scalar coarser than `f64`, `c` is also off by the rounding of `A`'s entries (a cone
+/// turned in `f32`: about 10⁻⁷ `|p0|²`), so the bar is at least four times that bound.
+fn clear_of_zero<T: Scalar>(c: f64, p0: [f64; 3]) -> bool {
+    let level = REGULAR_LEVEL.max(4.0 * rounding_of::<T>());
+    c.abs() > level * p0.iter().map(|x| x * x).sum::<f64>()
 }
 
 #[inline(always)]
@@ -393,7 +415,7 @@ impl<T: Scalar> NormalField<T> for LieField<T> {
     /// `pᵀ A p = 0`. A cone's apex is a singular point; other fields may have them.
     fn is_regular_through(&self, p0: [f64; 3]) -> bool {
         self.quadric_through(p0)
-            .is_some_and(|(_, c)| clear_of_zero(c, p0))
+            .is_some_and(|(_, c)| clear_of_zero::<T>(c, p0))
     }
 
     /// For a quadric `pᵀ A p = c` (`c` clear of zero) with exactly one eigenvalue `λ` of `A`
@@ -403,7 +425,7 @@ impl<T: Scalar> NormalField<T> for LieField<T> {
     /// other two eigenvalues `μ`.
     fn hole_through(&self, p0: [f64; 3]) -> Option<Hole> {
         let (eigenvalues, vectors, c) = self.quadric_frame_through(p0)?;
-        if !clear_of_zero(c, p0) {
+        if !clear_of_zero::<T>(c, p0) {
             return None;
         }
         let across = |k: usize| eigenvalues[k] * c <= 0.0 || eigenvalues[k].abs() <= 1e-12;
