@@ -179,7 +179,7 @@ pub struct MeshParams {
     /// δ' in (0, 1): step shrink when it turns more than β_max.
     pub shrink: f64,
     /// Insert a curve when neighbouring curves are more than `gap` × the local step apart, or
-    /// their normals more than `gap` × β_max (proposed method).
+    /// their normals more than `gap` × β_max (proposed method); 1 to 100.
     pub gap: f64,
     /// End a curve when it comes closer than `merge` × the local step to a neighbour
     /// (proposed method; below `gap / 2` so that inserting and merging cannot chase each
@@ -703,11 +703,15 @@ impl MeshParams {
         if !(self.shrink > 0.0 && self.shrink < 1.0) {
             return Err(MeshError::ShrinkFactor(self.shrink));
         }
-        if !(self.gap > 0.5 && self.gap <= 100.0) {
+        // Below a step, inserted curves start nearer their neighbours than they step and go
+        // on inserting: fig3 at `gap` 0.6 (`merge` 0) laid 49,370 curves for 5,186 triangles
+        // within 10⁵ points, and ran for minutes into the default budget.
+        if !(self.gap >= 1.0 && self.gap <= 100.0) {
             return Err(MeshError::OutOfRange {
                 name: "gap",
                 value: self.gap,
-                why: "the insertion threshold must lie in (0.5, 100] step lengths",
+                why: "the insertion threshold must lie in [1, 100] step lengths (closer curves \
+                      go on inserting more)",
             });
         }
         if !(self.merge >= 0.0 && self.merge < self.gap / 2.0) {

@@ -158,7 +158,7 @@ pub struct Overrides {
     #[arg(long, allow_hyphen_values = true, value_parser = parse_finite)]
     #[serde(skip_serializing_if = "Option::is_none")]
     pub shrink: Option<f64>,
-    /// Insert a curve when neighbours are this many steps apart.
+    /// Insert a curve when neighbours are this many steps apart (1 to 100).
     #[arg(long, allow_hyphen_values = true, value_parser = parse_finite)]
     #[serde(skip_serializing_if = "Option::is_none")]
     pub gap: Option<f64>,
