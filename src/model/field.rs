@@ -281,7 +281,9 @@ impl<T: Scalar> LieField<T> {
 
     /// For a quadric (`B = 0`, `A` symmetric), the eigenvalues of `A` and the level
     /// `c = p0ᵀ A p0`, both for `A` scaled to entries of order one (so that the eigen solver
-    /// neither overflows nor underflows; the semi-axes `√(c / λ)` do not change).
+    /// neither overflows nor underflows; the semi-axes `√(c / λ)` do not change). Eigenvalues
+    /// within the rounding of `A` ([`rounding_of`]) are exactly zero, so callers test `λ c`'s
+    /// sign alone.
     fn quadric_through(&self, p0: [f64; 3]) -> Option<([f64; 3], f64)> {
         self.quadric_frame_through(p0).map(|(l, _, c)| (l, c))
     }
@@ -404,7 +406,7 @@ impl<T: Scalar> NormalField<T> for LieField<T> {
         let (eigenvalues, c) = self.quadric_through(p0)?;
         let size = eigenvalues
             .iter()
-            .filter(|&&l| l * c > 0.0 && (l.abs() > 1e-12))
+            .filter(|&&l| l * c > 0.0)
             .map(|&l| (c / l).sqrt())
             .fold(None, |m: Option<f64>, x| Some(m.map_or(x, |m| m.max(x))));
         size.filter(|s| s.is_finite() && *s > 0.0)
@@ -428,7 +430,7 @@ impl<T: Scalar> NormalField<T> for LieField<T> {
         if !clear_of_zero::<T>(c, p0) {
             return None;
         }
-        let across = |k: usize| eigenvalues[k] * c <= 0.0 || eigenvalues[k].abs() <= 1e-12;
+        let across = |k: usize| eigenvalues[k] * c <= 0.0;
         let mut axes = (0..3).filter(|&k| across(k));
         let (Some(k), None) = (axes.next(), axes.next()) else {
             return None;
@@ -447,7 +449,7 @@ impl<T: Scalar> NormalField<T> for LieField<T> {
     /// its semi-axes `√(c / λ)`, shortest first.
     fn semi_axes_through(&self, p0: [f64; 3]) -> Option<[f64; 3]> {
         let (eigenvalues, c) = self.quadric_through(p0)?;
-        if !eigenvalues.iter().all(|&l| l * c > 0.0 && l.abs() > 1e-12) {
+        if !eigenvalues.iter().all(|&l| l * c > 0.0) {
             return None;
         }
         let mut axes = eigenvalues.map(|l| (c / l).sqrt());

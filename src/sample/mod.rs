@@ -360,20 +360,21 @@ pub(crate) fn sample_resolved<T: Scalar, F: NormalField<T>>(
             parent: None,
             end: CurveEnd::Budget,
         });
+        let (left, right) = ((j + n - 1) % n, (j + 1) % n);
         s.live.push(Live {
             p: p0.clone(),
             carry: dir,
             dt: T::from_f64(params.dt),
             s: 0.0,
-            left: (j + n - 1) % n,
-            right: (j + 1) % n,
+            left,
+            right,
             active: true,
             drift: 0.0,
             chart_dir: [theta.cos(), theta.sin()],
             cooldown: [0.0; 2],
             inserted_from: None,
             // Every curve of the fan starts at p0, no gap from its neighbours.
-            last_gap: [((j + 1) % n, 0.0), ((j + n - 1) % n, 0.0)],
+            last_gap: [(right, 0.0), (left, 0.0)],
         });
         s.heap.push(Reverse((s.order_key(0.0), j)));
     }
