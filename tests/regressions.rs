@@ -1694,3 +1694,46 @@ fn an_insertion_gap_below_one_step_is_a_parameter_error() {
     let run = liemesh::run(&sphere(), &params).unwrap();
     assert!(run.validation.is_closed(), "{}", run.validation);
 }
+
+/// [`QuarticTorus`] (R = 2, a = 0.75) magnified `scale` times: its field at `p / scale`.
+struct MagnifiedTorus {
+    scale: f64,
+}
+
+impl liemesh::model::FieldFormula for MagnifiedTorus {
+    fn normal<T: liemesh::scalar::Scalar>(&self, p: &Vec3<T>) -> Vec3<T> {
+        let shrink = T::from_f64(1.0 / self.scale);
+        let q = Vec3::new(
+            p.x.clone() * shrink.clone(),
+            p.y.clone() * shrink.clone(),
+            p.z.clone() * shrink,
+        );
+        QuarticTorus {
+            big: 2.0,
+            small: 0.75,
+        }
+        .normal(&q)
+    }
+}
+
+/// Found by meshing surfaces of one's own in `f32` at several scales: the integrability test
+/// held the field's defect to 10⁻⁹ whatever the scalar, and rounding in `f32` leaves about
+/// 10⁻⁷, so at points away from `p0` a torus magnified ten or a thousand times passed for a
+/// twisted field: it was stitched without new points and kept three triangular holes (12,343
+/// triangles, χ = −3; magnified by a power of two, whose coordinates round exactly, it
+/// closed). The bar is now a thousand units of the scalar's roundoff where that is above 10⁻⁹.
+#[test]
+fn a_torus_of_ones_own_in_f32_closes_at_any_scale() {
+    for scale in [10.0, 1e-3] {
+        let torus = liemesh::model::Formula(MagnifiedTorus { scale });
+        let params = MeshParams::at([2.75 * scale, 0.0, 0.0]);
+        let in_f32 = liemesh::run::<f32, _>(&torus, &params).unwrap();
+        let in_f64 = liemesh::run::<f64, _>(&torus, &params).unwrap();
+        for v in [&in_f32.validation, &in_f64.validation] {
+            assert!(v.is_closed() && v.genus() == Some(1), "scale {scale}: {v}");
+        }
+        assert_eq!(in_f32.stitched.holes, 0, "scale {scale}");
+        let (a, b) = (in_f64.mesh.triangles.len(), in_f32.mesh.triangles.len());
+        assert!(a.abs_diff(b) * 100 <= a, "scale {scale}: f64 {a}, f32 {b}");
+    }
+}

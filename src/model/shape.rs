@@ -9,11 +9,23 @@ use crate::scalar::{Scalar, Vec3};
 
 /// A field whose [integrability defect](LocalShape::integrability_defect) stays below this is
 /// treated as integrable (rounding leaves about 1e-16 on the model's integrable fields; a
-/// rotation of 0.001 rad leaves 1e-3).
+/// rotation of 0.001 rad leaves 1e-3), or below a thousand units of roundoff of the scalar
+/// type the field is evaluated in, where that is larger
+/// ([`LocalShape::integrable_below`]).
 pub const INTEGRABLE_DEFECT: f64 = 1e-9;
+
+/// The defect below which a field evaluated in `T` counts as integrable: [`INTEGRABLE_DEFECT`],
+/// or a thousand units of `T`'s roundoff if that is larger. In `f32` rounding alone leaves
+/// defects near 10⁻⁷: a torus of one's own at ten times unit size was taken for a twisted field
+/// at points away from `p0`, stitched without new points, and kept three triangular holes
+/// (closed at unit size, where its coordinates happen to round exactly).
+fn integrable_below<T: Scalar>() -> f64 {
+    INTEGRABLE_DEFECT.max(1e3 * T::unit_roundoff())
+}
 
 /// The local shape of the surface through a point.
 #[derive(Clone, Copy, Debug, PartialEq)]
+#[non_exhaustive]
 pub struct LocalShape {
     /// The unit field normal.
     pub normal: [f64; 3],
@@ -27,6 +39,9 @@ pub struct LocalShape {
     /// family of surfaces (Frobenius), of order one where it is far from any. Free of units:
     /// the same for the field scaled by any factor and for the surface scaled about any point.
     pub integrability_defect: f64,
+    /// The defect below which the field counts as integrable here ([`INTEGRABLE_DEFECT`],
+    /// raised to a thousand units of roundoff of the scalar type it was evaluated in).
+    pub integrable_below: f64,
 }
 
 impl LocalShape {
@@ -75,12 +90,14 @@ impl LocalShape {
             tangent,
             curvatures,
             integrability_defect,
+            integrable_below: integrable_below::<T>(),
         })
     }
 
-    /// Whether the field is integrable here: its defect is below [`INTEGRABLE_DEFECT`].
+    /// Whether the field is integrable here: its defect is below
+    /// [`integrable_below`](Self::integrable_below).
     pub fn is_integrable(&self) -> bool {
-        self.integrability_defect < INTEGRABLE_DEFECT
+        self.integrability_defect < self.integrable_below
     }
 
     /// The radius of curvature in the most curved direction, `1/|κ|max` (infinite on a flat
