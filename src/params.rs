@@ -443,7 +443,7 @@ const STEPS_ACROSS_RADIUS: f64 = 12.0;
 const CENTRE_REACH: f64 = 16.0;
 
 /// A curl below this, relative to the Jacobian's size, is a gradient's rounding (in `f64`;
-/// in a type of less precision, a thousand units of its roundoff).
+/// in a type of less precision, [`jacobian_rounding`](crate::model::jacobian_rounding)).
 const CURL_FREE: f64 = 1e-10;
 
 /// Whether the field has a curl at `p0` or half a step's scale from it along any axis (seven
@@ -468,7 +468,7 @@ fn has_curl_near<T: Scalar, F: NormalField<T> + ?Sized>(
         let curl = [j[2][1] - j[1][2], j[0][2] - j[2][0], j[1][0] - j[0][1]];
         let size = j.iter().flatten().map(|x| x * x).sum::<f64>().sqrt();
         let curl = curl.iter().map(|x| x * x).sum::<f64>().sqrt();
-        let rounding = CURL_FREE.max(1e3 * T::unit_roundoff());
+        let rounding = CURL_FREE.max(crate::model::jacobian_rounding::<T>());
         curl.is_finite() && size.is_finite() && curl > rounding * size
     })
 }

@@ -18,4 +18,5 @@ pub use field::{jacobian, FnField, Hole, LieField, NormalField};
 pub use formula::{EveryScalar, FieldFormula, Formula};
 pub use invariant::{AngleReading, Invariant, InvariantError, InvariantKind, Lift, Mat3};
 pub(crate) use shape::bend_has_singular_point;
+pub(crate) use shape::jacobian_rounding;
 pub use shape::{least_aligned_tangent, LocalShape, INTEGRABLE_DEFECT};

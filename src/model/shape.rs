@@ -20,7 +20,14 @@ pub const INTEGRABLE_DEFECT: f64 = 1e-9;
 /// at points away from `p0`, stitched without new points, and kept three triangular holes
 /// (closed at unit size, where its coordinates happen to round exactly).
 fn integrable_below<T: Scalar>() -> f64 {
-    INTEGRABLE_DEFECT.max(1e3 * T::unit_roundoff())
+    INTEGRABLE_DEFECT.max(jacobian_rounding::<T>())
+}
+
+/// What rounding in `T` may leave in a number read off a field's Jacobian relative to its
+/// size (a curl, a twist): a thousand units of `T`'s roundoff. The floor below which a field
+/// evaluated in `T` cannot be told from a curl-free or integrable one.
+pub(crate) fn jacobian_rounding<T: Scalar>() -> f64 {
+    1e3 * T::unit_roundoff()
 }
 
 /// The local shape of the surface through a point.
