@@ -329,16 +329,18 @@ pub fn run_observed<T: Scalar, F: NormalField<T>>(
     let improve = params.mode == Mode::Default;
     // The axis of the hole the field knows, which no face may meet.
     let axis = params.hole.map(|h| h.axis());
-    let (mut mesh, chart, mut vertices, stitched) =
-        assemble(field, params, &samples, improve, axis, observe)?;
+    let chart = triangulate::chart_triangulation(&samples)?;
+    let (mut mesh, mut vertices, stitched) =
+        assemble(field, params, &samples, &chart, improve, axis, observe);
     lap(&mut timings.triangulating, &mut since);
     // Where every vertex was before relaxation, for taking back a relaxation move that makes
     // faces cross. Everything up to here is deterministic, so that state is rebuilt from the
-    // samples on the rare run that needs it rather than copied on every run (a copy of the
-    // whole mesh held through relaxation and validation: 48 MB at 10⁶ triangles).
+    // samples and their chart triangulation on the rare run that needs it rather than copied
+    // on every run (a copy of the whole mesh held through relaxation and validation: 48 MB at
+    // 10⁶ triangles).
     let before_relaxation = || {
-        let (mut mesh, _, working, _) =
-            assemble(field, params, &samples, improve, axis, &|_| {}).ok()?;
+        let (mut mesh, working, _) =
+            assemble(field, params, &samples, &chart, improve, axis, &|_| {});
         // Without the faces peeled off beside a singular point below, should untangling go
         // back to these triangles.
         triangulate::peel_faces_beside_singular_points(field, &samples, &mut mesh);
@@ -467,16 +469,11 @@ pub fn run_observed<T: Scalar, F: NormalField<T>>(
     })
 }
 
-/// What [`assemble`] gives: the mesh, its chart triangulation, its vertices in the working
-/// precision and what the stitching did.
-type Assembled<T> = (
-    Mesh,
-    triangulate::ChartTriangulation,
-    Vec<scalar::Vec3<T>>,
-    triangulate::Stitched,
-);
+/// What [`assemble`] gives: the mesh, its vertices in the working precision and what the
+/// stitching did.
+type Assembled<T> = (Mesh, Vec<scalar::Vec3<T>>, triangulate::Stitched);
 
-/// The mesh as it stands before relaxation: the samples' chart triangulation, stitched
+/// The mesh as it stands before relaxation: the samples' chart triangulation `chart`, stitched
 /// where fronts meet (when the run closes its mesh) and then flipped to surface Delaunay
 /// (when it is improved). A function of its arguments alone: [`run_observed`] builds it
 /// again to take relaxation moves back.
@@ -484,13 +481,13 @@ fn assemble<T: Scalar, F: NormalField<T>>(
     field: &F,
     params: &Resolved,
     samples: &sample::Samples<T>,
+    chart: &triangulate::ChartTriangulation,
     improve: bool,
     axis: Option<[[f64; 3]; 2]>,
     observe: &dyn Fn(Progress),
-) -> Result<Assembled<T>, MeshError> {
+) -> Assembled<T> {
     // A mesh that is stitched is flipped to surface Delaunay once it is whole, not as a chart.
-    let (mut mesh, chart) =
-        triangulate::triangulate(samples, params.close, improve && !params.close)?;
+    let mut mesh = triangulate::mesh_of_chart(samples, chart, improve && !params.close);
     // The mesh's vertices in the working precision, found by provenance.
     let mut vertices = triangulate::sample_vertices(samples, &mesh);
     let stitched = if params.close {
@@ -500,7 +497,7 @@ fn assemble<T: Scalar, F: NormalField<T>>(
             samples.curves.len(),
             mesh.triangles.len(),
         ));
-        let stitched = triangulate::stitch(field, params, samples, &mut mesh, &mut vertices);
+        let stitched = triangulate::stitch(field, params, samples, chart, &mut mesh, &mut vertices);
         if improve {
             triangulate::flip_to_surface_delaunay(&mut mesh, axis);
         }
@@ -508,7 +505,7 @@ fn assemble<T: Scalar, F: NormalField<T>>(
     } else {
         Default::default()
     };
-    Ok((mesh, chart, vertices, stitched))
+    (mesh, vertices, stitched)
 }
 
 /// Meshes the surface of `field` with `params`.

@@ -90,6 +90,19 @@ pub fn triangulate<T: Scalar>(
     _close: bool,
     improve: bool,
 ) -> Result<(Mesh, ChartTriangulation), MeshError> {
+    let chart = chart_triangulation(samples)?;
+    let mesh = mesh_of_chart(samples, &chart, improve);
+    Ok((mesh, chart))
+}
+
+/// The chart triangulation of `samples`: spade's constrained Delaunay triangulation of their
+/// chart points inside the front, without the triangles that span a place where the chart is
+/// not the surface. The costly half of [`triangulate`] (spade's bulk load), done once a run:
+/// the stitching's retries and the state before relaxation rebuild the mesh from it with
+/// [`mesh_of_chart`].
+pub(crate) fn chart_triangulation<T: Scalar>(
+    samples: &Samples<T>,
+) -> Result<ChartTriangulation, MeshError> {
     check_samples(samples)?;
     let n = samples.points.len();
     if n < 3 {
@@ -121,7 +134,24 @@ pub fn triangulate<T: Scalar>(
     // (inserted curves' chart positions are interpolated): they go, with the triangles
     // around them, and the stitching fills the hole in space.
     drop_folds(&pos, &normals, &mut triangles);
-    let mut all = triangles.clone();
+    Ok(ChartTriangulation {
+        chart,
+        triangles,
+        front,
+        closing: Vec::new(),
+    })
+}
+
+/// The mesh of `samples` that `chart` (their [`chart_triangulation`]) gives, flipped to
+/// surface Delaunay with `improve`.
+pub(crate) fn mesh_of_chart<T: Scalar>(
+    samples: &Samples<T>,
+    chart: &ChartTriangulation,
+    improve: bool,
+) -> Mesh {
+    let pos: Vec<[f64; 3]> = samples.points.iter().map(|p| p.to_f64()).collect();
+    let normals: Vec<[f64; 3]> = samples.normals.iter().map(|v| v.to_f64()).collect();
+    let mut all = chart.triangles.clone();
     if improve {
         let budget = 8 * all.len() + 64;
         flip::flip_to_surface_delaunay(&pos, &normals, &mut all, budget, &[], None);
@@ -132,16 +162,7 @@ pub fn triangulate<T: Scalar>(
         let [a, b, c] = t.map(|i| pos[i as usize]);
         cross3(sub3(b, a), sub3(c, a)) != [0.0; 3]
     });
-    let mesh = assemble(samples, &pos, &all);
-    Ok((
-        mesh,
-        ChartTriangulation {
-            chart,
-            triangles,
-            front,
-            closing: Vec::new(),
-        },
-    ))
+    assemble(samples, &pos, &all)
 }
 
 /// Flips edges of `mesh` until it is Delaunay on the surface (at most 8 flips a triangle):
@@ -314,6 +335,7 @@ pub(crate) fn stitch<T: Scalar, F: NormalField<T>>(
     field: &F,
     params: &Resolved,
     samples: &Samples<T>,
+    chart: &ChartTriangulation,
     mesh: &mut Mesh,
     vertices: &mut Vec<Vec3<T>>,
 ) -> Stitched {
@@ -321,7 +343,7 @@ pub(crate) fn stitch<T: Scalar, F: NormalField<T>>(
     // the chart is a disc) go first; the stitching then holds its own to the same line.
     let axis = params.hole.map(|h| h.axis());
     let across = drop_across(mesh, axis);
-    let mut stitched = stitch_chart(field, params, samples, mesh, vertices, axis);
+    let mut stitched = stitch_chart(field, params, samples, chart, mesh, vertices, axis);
     stitched.removed += across;
     stitched
 }
@@ -439,6 +461,7 @@ fn stitch_chart<T: Scalar, F: NormalField<T>>(
     field: &F,
     params: &Resolved,
     samples: &Samples<T>,
+    chart: &ChartTriangulation,
     mesh: &mut Mesh,
     vertices: &mut Vec<Vec3<T>>,
     axis: Option<[[f64; 3]; 2]>,
@@ -475,11 +498,9 @@ fn stitch_chart<T: Scalar, F: NormalField<T>>(
         well_shaped: false,
         ..growth
     };
-    // The chart's mesh, triangulated once more for both retries below (unflipped, as the first
-    // attempt's: the stitched mesh is flipped afterwards).
-    let Ok((mut chart_mesh, _)) = triangulate(samples, params.close, false) else {
-        return stitched;
-    };
+    // The chart's mesh once more for both retries below (unflipped, as the first attempt's:
+    // the stitched mesh is flipped afterwards).
+    let mut chart_mesh = mesh_of_chart(samples, chart, false);
     drop_across(&mut chart_mesh, axis);
     let mut again = chart_mesh.clone();
     let mut again_vertices = sample_vertices(samples, &again);
