@@ -16,6 +16,7 @@
 //!    the field's are split (new vertices on the surface) until none does: see
 //!    [`Refinement`].
 
+mod chart_delaunay;
 mod flip;
 mod proximity;
 mod refine;
@@ -50,7 +51,7 @@ use crate::sample::{CurveEnd, Samples};
 use crate::scalar::{Scalar, Vec3};
 use crate::trace::StepConfig;
 use crate::NormalField;
-use spade::{ConstrainedDelaunayTriangulation, HasPosition, Point2, Triangulation as _};
+use spade::{HasPosition, Point2, Triangulation as _};
 use std::collections::HashMap;
 
 /// The chart-1 triangulation, kept for audits (empty-circumcircle checks, snapshots).
@@ -838,7 +839,7 @@ fn chart_triangles(chart: &[[f64; 2]], front: &[u32]) -> Result<Vec<[u32; 3]>, M
         .collect();
     let m = front.len();
     let use_front = m >= 3 && star_shaped(chart, front);
-    let cdt = ConstrainedDelaunayTriangulation::<ChartVertex>::bulk_load(vertices)
+    let cdt = chart_delaunay::triangulate(vertices)
         .map_err(|e| MeshError::Triangulation(format!("spade rejected a chart point: {e:?}")))?;
     let mut cdt = cdt;
     if m >= 3 {
