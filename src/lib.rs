@@ -337,10 +337,19 @@ pub fn run_observed<T: Scalar, F: NormalField<T>>(
     // faces cross. Everything up to here is deterministic, so that state is rebuilt from the
     // samples and their chart triangulation on the rare run that needs it rather than copied
     // on every run (a copy of the whole mesh held through relaxation and validation: 48 MB at
-    // 10⁶ triangles).
+    // 10⁶ triangles). A mesh made mostly by the stitching is copied instead: rebuilding it
+    // would stitch it all again (40 s of a gyroid's run), and the two states are the same.
+    let stitched_most = improve && 4 * stitched.added >= mesh.triangles.len();
+    let copied = stitched_most.then(|| (mesh.clone(), vertices.clone()));
     let before_relaxation = || {
-        let (mut mesh, working, _) =
-            assemble(field, params, &samples, &chart, improve, axis, &|_| {});
+        let (mut mesh, working) = match &copied {
+            Some((mesh, working)) => (mesh.clone(), working.clone()),
+            None => {
+                let (mesh, working, _) =
+                    assemble(field, params, &samples, &chart, improve, axis, &|_| {});
+                (mesh, working)
+            }
+        };
         // Without the faces peeled off beside a singular point below, should untangling go
         // back to these triangles.
         triangulate::peel_faces_beside_singular_points(field, &samples, &mut mesh);
