@@ -340,10 +340,11 @@ pub fn run_observed<T: Scalar, F: NormalField<T>>(
     // 10⁶ triangles). A mesh made mostly by the stitching is copied instead: rebuilding it
     // would stitch it all again (40 s of a gyroid's run), and the two states are the same.
     let stitched_most = improve && 4 * stitched.added >= mesh.triangles.len();
-    let copied = stitched_most.then(|| (mesh.clone(), vertices.clone()));
-    let before_relaxation = || {
-        let (mut mesh, working) = match &copied {
-            Some((mesh, working)) => (mesh.clone(), working.clone()),
+    let mut copied = stitched_most.then(|| (mesh.clone(), vertices.clone()));
+    // Called at most once (its result is kept in `before`), so the copy is handed over.
+    let mut before_relaxation = || {
+        let (mut mesh, working) = match copied.take() {
+            Some(copy) => copy,
             None => {
                 let (mesh, working, _) =
                     assemble(field, params, &samples, &chart, improve, axis, &|_| {});

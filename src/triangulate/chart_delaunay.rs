@@ -20,7 +20,7 @@
 //! equally Delaunay triangulations: the choice is a function of the chart, and no chart of the
 //! gallery, the figures or the benchmarks reaches it (their ratios are 1.00–1.46).
 
-use super::ChartVertex;
+use super::{cross2, sector, sub2, ChartVertex};
 use spade::{ConstrainedDelaunayTriangulation, HasPosition, InsertionError, Triangulation as _};
 
 /// A chart with fewer points than this is bulk loaded whatever its shape: below it even deep
@@ -67,15 +67,14 @@ fn pocketed(vertices: &[ChartVertex]) -> bool {
         mean = [mean[0] + x, mean[1] + y];
     }
     let mean = [mean[0] / n as f64, mean[1] / n as f64];
-    // The farthest point of each sector, by the pseudo-angle (monotone in the angle, no
-    // arctangent per point); each sector's true angular width comes from its bounds.
+    // The farthest point of each sector of the pseudo-angle (no arctangent per point); each
+    // sector's true angular width comes from its bounds.
     let mut far = [(0.0_f64, [0.0_f64; 2]); SECTORS];
     for v in vertices {
         let [x, y] = xy(v);
-        let (dx, dy) = (x - mean[0], y - mean[1]);
-        let r2 = dx * dx + dy * dy;
-        if r2 > 0.0 {
-            let s = ((pseudo_angle(dx, dy) / 4.0 * SECTORS as f64) as usize).min(SECTORS - 1);
+        let d = [x - mean[0], y - mean[1]];
+        if let Some(s) = sector(SECTORS, d) {
+            let r2 = d[0] * d[0] + d[1] * d[1];
             if r2 > far[s].0 {
                 far[s] = (r2, [x, y]);
             }
@@ -86,22 +85,10 @@ fn pocketed(vertices: &[ChartVertex]) -> bool {
     outline > 0.0 && hull_area(extremes) >= POCKETED_AREA_RATIO * outline
 }
 
-/// A monotone stand-in for the angle of `(dx, dy)`, in `[0, 4)`.
-fn pseudo_angle(dx: f64, dy: f64) -> f64 {
-    let p = dy / (dx.abs() + dy.abs());
-    if dx < 0.0 {
-        2.0 - p
-    } else if dy < 0.0 {
-        4.0 + p
-    } else {
-        p
-    }
-}
-
 /// The angle (radians) that sector `s` of [`SECTORS`] spans: pseudo-angles
-/// `[4s/SECTORS, 4(s+1)/SECTORS)`.
+/// `[4s/SECTORS, 4(s+1)/SECTORS)` ([`super::pseudo_angle`]).
 fn sector_width(s: usize) -> f64 {
-    // The angle of pseudo-angle q: inverse of `pseudo_angle` on each quadrant.
+    // The angle of pseudo-angle q: the inverse of `pseudo_angle` on each quadrant.
     let angle = |q: f64| {
         let quadrant = (q.floor() as i32).clamp(0, 3);
         let t = q - quadrant as f64; // 0..1 within the quadrant
@@ -115,9 +102,7 @@ fn sector_width(s: usize) -> f64 {
 /// The area of the convex hull of `points` (Andrew's monotone chain).
 fn hull_area(mut points: Vec<[f64; 2]>) -> f64 {
     points.sort_by(|a, b| a[0].total_cmp(&b[0]).then(a[1].total_cmp(&b[1])));
-    let turn = |o: [f64; 2], a: [f64; 2], b: [f64; 2]| {
-        (a[0] - o[0]) * (b[1] - o[1]) - (a[1] - o[1]) * (b[0] - o[0])
-    };
+    let turn = |o: [f64; 2], a: [f64; 2], b: [f64; 2]| cross2(sub2(a, o), sub2(b, o));
     let mut hull: Vec<[f64; 2]> = Vec::with_capacity(2 * points.len());
     for pass in 0..2 {
         let start = hull.len();
@@ -138,10 +123,7 @@ fn hull_area(mut points: Vec<[f64; 2]>) -> f64 {
     }
     let m = hull.len();
     (0..m)
-        .map(|i| {
-            let (a, b) = (hull[i], hull[(i + 1) % m]);
-            a[0] * b[1] - a[1] * b[0]
-        })
+        .map(|i| cross2(hull[i], hull[(i + 1) % m]))
         .sum::<f64>()
         / 2.0
 }
@@ -216,7 +198,7 @@ mod tests {
         // The pseudo-angle of a direction falls in the sector whose true bounds hold it.
         for k in 0..1000 {
             let a = std::f64::consts::TAU * (k as f64 + 0.5) / 1000.0;
-            let s = (pseudo_angle(a.cos(), a.sin()) / 4.0 * SECTORS as f64) as usize;
+            let s = sector(SECTORS, [a.cos(), a.sin()]).unwrap();
             let start: f64 = (0..s).map(sector_width).sum();
             assert!(
                 start <= a + 1e-12 && a < start + sector_width(s) + 1e-12,
